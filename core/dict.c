@@ -1,0 +1,2 @@
+/* dict.c: placeholder, being written. */
+typedef int mf_placeholder_dict;

@@ -1,0 +1,2 @@
+/* kernel.c: placeholder, being written. */
+typedef int mf_placeholder_kernel;

@@ -1,0 +1,2 @@
+/* log.c: placeholder, being written. */
+typedef int mf_placeholder_log;

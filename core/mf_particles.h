@@ -1,0 +1,98 @@
+/* mf_particles.h: particle storage, a structure of arrays.
+ *
+ * Hot data that the neighbour loops read (positions, kinds) are compact
+ * arrays; everything else is an optional field that exists only when a
+ * module asks for it (no pressure array in a pure advection test, no fluid
+ * id for one fluid).
+ *
+ * Vectors are stored with three components even in 2-D (z = 0): one code
+ * path, and the 2-D memory overhead is small next to the neighbour lists.
+ *
+ * MPI layout (one rank for now): a rank owns particles [0, n_owned) and may
+ * hold halo copies after them [n_owned, n). Ids are 64-bit, unique across
+ * ranks: a rank hands out ids from its own block (id_base + counter), so no
+ * communication is needed to add particles. Globally indexed objects
+ * (matrix rows) are a per-rank range plus an offset (global_offset).
+ */
+#ifndef MF_PARTICLES_H
+#define MF_PARTICLES_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+typedef enum {
+    MF_FLUID = 0,
+    MF_WALL = 1,   /* first layer of fixed particles: in the pressure equation */
+    MF_DUMMY = 2,  /* outer fixed layers: only in the number density */
+    MF_INLET = 3,
+    MF_OUTLET = 4,
+    MF_NKINDS
+} mf_particle_kind;
+
+const char *mf_particle_kind_name(int kind);
+
+/* Optional per-particle fields, requested by modules by name. */
+#define MF_MAX_FIELDS 32
+typedef struct mf_field {
+    char name[32];
+    int ncomp;        /* 1 scalar, 3 vector */
+    int type;         /* MF_FIELD_DOUBLE or MF_FIELD_INT32 */
+    void *data;       /* ncomp * cap elements */
+    bool output;      /* written to snapshots */
+} mf_field;
+
+enum { MF_FIELD_DOUBLE = 0, MF_FIELD_INT32 = 1 };
+
+typedef struct mf_particles {
+    int dim;            /* 2 or 3 */
+    size_t n;           /* owned + halo */
+    size_t n_owned;
+    size_t cap;
+    double *pos;        /* 3 * cap */
+    double *vel;        /* 3 * cap */
+    uint8_t *kind;      /* cap */
+    int64_t *id;        /* cap */
+    int nfields;
+    mf_field field[MF_MAX_FIELDS];
+    /* Distributed layout. */
+    int rank, nranks;
+    int64_t global_offset; /* first global row of this rank's owned particles */
+    int64_t id_base;       /* this rank's id block start */
+    int64_t next_id;       /* next id handed out (>= id_base) */
+} mf_particles;
+
+int mf_particles_create(int dim, size_t cap, mf_particles **out);
+void mf_particles_destroy(mf_particles *p);
+int mf_particles_reserve(mf_particles *p, size_t cap);
+
+/* Append one owned particle; a fresh unique id is assigned and returned in
+ * *id_out (may be NULL). Optional fields of the new particle are zero. */
+int mf_particles_add(mf_particles *p, int kind, const double x[3], const double v[3],
+                     int64_t *id_out);
+/* Remove the particles whose flag is set (n entries): compacts in place,
+ * keeping the order of the rest; ids are never reused. Returns the count
+ * removed in *nremoved. */
+int mf_particles_remove(mf_particles *p, const uint8_t *remove_flag, size_t *nremoved);
+/* Apply a permutation: new index k holds old index perm[k]. Every array,
+ * optional fields included, follows. */
+int mf_particles_permute(mf_particles *p, const size_t *perm);
+
+/* Optional fields. Requesting an existing name with the same shape returns
+ * it; with another shape is an error. */
+int mf_particles_request_field(mf_particles *p, const char *name, int ncomp, int type,
+                               bool output, int *index);
+int mf_particles_field_index(const mf_particles *p, const char *name); /* -1 if absent */
+static inline double *mf_particles_fd(const mf_particles *p, int index)
+{
+    return (double *)p->field[index].data;
+}
+static inline int32_t *mf_particles_fi(const mf_particles *p, int index)
+{
+    return (int32_t *)p->field[index].data;
+}
+
+void mf_particles_count_kinds(const mf_particles *p, size_t counts[MF_NKINDS]);
+size_t mf_particles_memory(const mf_particles *p); /* bytes held */
+
+#endif

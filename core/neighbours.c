@@ -1,0 +1,2 @@
+/* neighbours.c: placeholder, being written. */
+typedef int mf_placeholder_neighbours;

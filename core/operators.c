@@ -1,0 +1,2 @@
+/* operators.c: placeholder, being written. */
+typedef int mf_placeholder_operators;

@@ -1,0 +1,2 @@
+/* params.c: placeholder, being written. */
+typedef int mf_placeholder_params;

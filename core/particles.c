@@ -1,0 +1,2 @@
+/* particles.c: placeholder, being written. */
+typedef int mf_placeholder_particles;

@@ -1,0 +1,2 @@
+/* registry.c: placeholder, being written. */
+typedef int mf_placeholder_registry;

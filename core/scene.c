@@ -1,0 +1,2 @@
+/* scene.c: placeholder, being written. */
+typedef int mf_placeholder_scene;

@@ -1,0 +1,2 @@
+/* timestep.c: placeholder, being written. */
+typedef int mf_placeholder_timestep;

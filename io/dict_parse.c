@@ -1,0 +1,2 @@
+/* placeholder */
+typedef int mf_placeholder_dict_parse;
