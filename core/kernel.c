@@ -1,2 +1,31 @@
-/* kernel.c: placeholder, being written. */
-typedef int mf_placeholder_kernel;
+/* kernel.c: n0 and lambda from an ideal full lattice (eqs. 3, 8). */
+#include "mf_kernel.h"
+
+#include "mf_error.h"
+
+int mf_kernel_init(mf_kernel *k, int dim, double l0, double re)
+{
+    if (dim != 2 && dim != 3)
+        return MF_ERROR(MF_ERR_INPUT, "dimension must be 2 or 3, not %d", dim);
+    if (!(l0 > 0) || !(re > l0))
+        return MF_ERROR(MF_ERR_INPUT,
+                        "kernel radius re = %g must exceed the particle spacing l0 = %g > 0", re,
+                        l0);
+    int m = (int)ceil(re / l0);
+    int mz = dim == 3 ? m : 0;
+    double n0 = 0.0, r2w = 0.0;
+    for (int ix = -m; ix <= m; ix++)
+        for (int iy = -m; iy <= m; iy++)
+            for (int iz = -mz; iz <= mz; iz++) {
+                double r = l0 * sqrt((double)(ix * ix + iy * iy + iz * iz));
+                double w = mf_weight(r, re);
+                n0 += w;
+                r2w += r * r * w;
+            }
+    k->dim = dim;
+    k->l0 = l0;
+    k->re = re;
+    k->n0 = n0;
+    k->lambda = r2w / n0; /* eq. 8 on the lattice */
+    return 0;
+}

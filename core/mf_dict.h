@@ -66,8 +66,18 @@ const char *mf_dict_intern(mf_dict *d, const char *s);
 /* Append (or replace, OpenFOAM's rule: the last one wins) an entry; takes
  * ownership of items. Returns the entry or NULL on allocation failure. */
 mf_entry *mf_dict_set(mf_dict *d, const char *key, mf_loc loc, size_t n, mf_value **items);
+/* Append an entry without looking for one with the same key: for a caller
+ * that knows the key is new (the parser keeps its own hash index, so that
+ * huge dictionaries stay linear). Ownership as for mf_dict_set: on failure
+ * the items are freed and NULL is returned. */
+mf_entry *mf_dict_append(mf_dict *d, const char *key, mf_loc loc, size_t n, mf_value **items);
+/* Give an existing entry new items (freeing the old ones, clearing `used`);
+ * takes ownership of items. */
+void mf_entry_replace(mf_entry *e, mf_loc loc, size_t n, mf_value **items);
 mf_value *mf_value_new(mf_value_kind kind, mf_loc loc);
 void mf_value_free(mf_value *v);
+/* Deep copy into the tree of parent (file names re-interned there); with
+ * parent NULL a dictionary value becomes a new root with its own pool. */
 mf_value *mf_value_copy(const mf_value *v, mf_dict *parent);
 /* Convenience builders used when writing resolved parameters. */
 int mf_dict_set_number(mf_dict *d, const char *key, double x);
@@ -98,7 +108,8 @@ int mf_value_number(const mf_value *v, const char *what, double *out);
 int mf_value_bool(const mf_value *v, const char *what, bool *out);
 int mf_value_vector(const mf_value *v, const char *what, double out[3]);
 
-/* Write the tree back in OpenFOAM syntax (round-trips through the parser). */
+/* Write the tree back in OpenFOAM syntax (round-trips through the parser).
+ * indent is the nesting level of d's entries (4 spaces each). */
 int mf_dict_write(const mf_dict *d, FILE *f, int indent);
 
 /* The closest key among candidates (Damerau-Levenshtein), or NULL if none

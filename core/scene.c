@@ -1,2 +1,326 @@
-/* scene.c: placeholder, being written. */
-typedef int mf_placeholder_scene;
+/* scene.c: fluid blocks and wall boxes on the particle lattice. */
+#include "mf_scene.h"
+
+#include <math.h>
+#include <stddef.h>
+#include <string.h>
+
+#include "mf_error.h"
+#include "mf_params.h"
+
+/* ---- fluids -------------------------------------------------------------- */
+typedef struct fluid_settings {
+    double rho, nu, sigma;
+} fluid_settings;
+
+static const mf_param fluid_params[] = {
+    {"rho", MF_PARAM_SCALAR, NULL, 1e-12, 1e12, NULL, offsetof(fluid_settings, rho),
+     "density, kg/m^3"},
+    {"nu", MF_PARAM_SCALAR, NULL, 0, 1e6, NULL, offsetof(fluid_settings, nu),
+     "kinematic viscosity, m^2/s"},
+    {"sigma", MF_PARAM_SCALAR, "0", 0, 1e6, NULL, offsetof(fluid_settings, sigma),
+     "surface tension coefficient, N/m"},
+};
+
+int mf_scene_read_fluids(const mf_dict *fluids, mf_sim *sim)
+{
+    char where[512];
+    sim->nfluids = 0;
+    for (size_t k = 0; k < fluids->n; k++) {
+        const mf_entry *e = fluids->entries[k];
+        if (strcmp(e->key, "FoamFile") == 0)
+            continue;
+        if (e->n != 1 || e->items[0]->kind != MF_VAL_DICT)
+            return MF_ERROR(MF_ERR_INPUT,
+                            "%s: '%s' must be a fluid sub-dictionary { rho ...; nu ...; }",
+                            mf_loc_str(e->loc, where, sizeof where), e->key);
+        if (sim->nfluids == MF_MAX_FLUIDS)
+            return MF_ERROR(MF_ERR_INPUT, "%s: at most %d fluids",
+                            mf_loc_str(e->loc, where, sizeof where), MF_MAX_FLUIDS);
+        if (strlen(e->key) >= sizeof sim->fluid[0].name)
+            return MF_ERROR(MF_ERR_INPUT, "%s: fluid name '%s' is too long",
+                            mf_loc_str(e->loc, where, sizeof where), e->key);
+        fluid_settings s;
+        MF_CALL(mf_params_apply(fluid_params, 3, e->items[0]->dict, NULL, &s, NULL));
+        mf_fluid *f = &sim->fluid[sim->nfluids++];
+        snprintf(f->name, sizeof f->name, "%s", e->key);
+        f->rho = s.rho;
+        f->nu = s.nu;
+        f->sigma = s.sigma;
+    }
+    if (sim->nfluids == 0)
+        return MF_ERROR(MF_ERR_INPUT, "%s: no fluid defined (add e.g. water { rho 1000; nu 1e-6; })",
+                        mf_loc_str(fluids->loc, where, sizeof where));
+    return 0;
+}
+
+int mf_scene_fluid_index(const mf_sim *sim, const char *name, int *index)
+{
+    const char *names[MF_MAX_FLUIDS];
+    char list[1024] = "";
+    for (int k = 0; k < sim->nfluids; k++) {
+        if (strcmp(sim->fluid[k].name, name) == 0) {
+            *index = k;
+            return 0;
+        }
+        names[k] = sim->fluid[k].name;
+        strncat(list, k ? ", " : "", sizeof list - strlen(list) - 1);
+        strncat(list, names[k], sizeof list - strlen(list) - 1);
+    }
+    const char *hint = mf_did_you_mean(name, names, (size_t)sim->nfluids);
+    return MF_ERROR(MF_ERR_INPUT, "unknown fluid '%s'%s%s%s; constant/fluids defines: %s", name,
+                    hint ? " (did you mean '" : "", hint ? hint : "", hint ? "'?)" : "", list);
+}
+
+/* ---- geometry ------------------------------------------------------------ */
+typedef struct geometry_settings {
+    long dimension;
+    double spacing;
+    const mf_dict *fluid_blocks, *walls;
+} geometry_settings;
+
+static const mf_param geometry_params[] = {
+    {"dimension", MF_PARAM_INT, NULL, 2, 3, NULL, offsetof(geometry_settings, dimension),
+     "2 or 3"},
+    {"particleSpacing", MF_PARAM_SCALAR, NULL, 1e-9, 1e6, NULL,
+     offsetof(geometry_settings, spacing), "l0, the initial particle spacing, m"},
+    {"fluidBlocks", MF_PARAM_DICT, NULL, MF_NO_RANGE, NULL,
+     offsetof(geometry_settings, fluid_blocks), "named blocks of fluid particles"},
+    {"walls", MF_PARAM_DICT, NULL, MF_NO_RANGE, NULL, offsetof(geometry_settings, walls),
+     "named walls (layers of fixed particles)"},
+};
+static const char *const geometry_extra[] = {"FoamFile", NULL};
+
+static const char *const block_types[] = {"box", NULL};
+
+typedef struct block_settings {
+    const char *type;
+    double min[3], max[3], velocity[3];
+    const char *fluid;
+} block_settings;
+
+static const mf_param block_params[] = {
+    {"type", MF_PARAM_WORD, "box", MF_NO_RANGE, block_types, offsetof(block_settings, type),
+     "shape of the block"},
+    {"min", MF_PARAM_VECTOR, NULL, MF_NO_RANGE, NULL, offsetof(block_settings, min),
+     "lower corner, m"},
+    {"max", MF_PARAM_VECTOR, NULL, MF_NO_RANGE, NULL, offsetof(block_settings, max),
+     "upper corner, m"},
+    {"velocity", MF_PARAM_VECTOR, "(0 0 0)", MF_NO_RANGE, NULL,
+     offsetof(block_settings, velocity), "initial velocity, m/s"},
+    {"fluid", MF_PARAM_WORD, NULL, MF_NO_RANGE, NULL, offsetof(block_settings, fluid),
+     "name of a fluid in constant/fluids"},
+};
+
+typedef struct wall_settings {
+    const char *type;
+    double min[3], max[3];
+    long wall_layers, dummy_layers;
+    const mf_dict *unused;
+} wall_settings;
+
+static const mf_param wall_params[] = {
+    {"type", MF_PARAM_WORD, "box", MF_NO_RANGE, block_types, offsetof(wall_settings, type),
+     "shape enclosed by the wall"},
+    {"min", MF_PARAM_VECTOR, NULL, MF_NO_RANGE, NULL, offsetof(wall_settings, min),
+     "lower corner of the enclosed region, m"},
+    {"max", MF_PARAM_VECTOR, NULL, MF_NO_RANGE, NULL, offsetof(wall_settings, max),
+     "upper corner of the enclosed region, m"},
+    {"wallLayers", MF_PARAM_INT, "1", 1, 3, NULL, offsetof(wall_settings, wall_layers),
+     "layers of wall particles (in the pressure equation)"},
+    {"dummyLayers", MF_PARAM_INT, "2", 0, 4, NULL, offsetof(wall_settings, dummy_layers),
+     "outer layers of dummy particles (number density only)"},
+};
+static const char *const wall_extra[] = {"open", NULL};
+
+/* Number of lattice points min + (i + 1/2) l0 that fit in [a, b]. The small
+ * tolerance keeps (b - a) / l0 = 50 from rounding down to 49. */
+static long lattice_count(double a, double b, double l0)
+{
+    return (long)floor((b - a) / l0 + 1e-9);
+}
+
+static int check_box(const char *what, const char *name, const mf_dict *d, const double *mn,
+                     const double *mx, int dim)
+{
+    char where[512];
+    for (int a = 0; a < dim; a++)
+        if (!(mx[a] > mn[a]))
+            return MF_ERROR(MF_ERR_INPUT, "%s: %s '%s': max must exceed min on every axis",
+                            mf_loc_str(d->loc, where, sizeof where), what, name);
+    return 0;
+}
+
+static int add_fluid_block(mf_sim *sim, const char *name, const mf_dict *d, int fluid_field,
+                           mf_dict *resolved)
+{
+    block_settings s;
+    mf_dict *out = resolved ? mf_dict_set_subdict(resolved, name) : NULL;
+    MF_CALL(mf_params_apply(block_params, 5, d, NULL, &s, out));
+    MF_CALL(check_box("fluid block", name, d, s.min, s.max, sim->dim));
+    int fid = 0;
+    if (mf_scene_fluid_index(sim, s.fluid, &fid) != 0) {
+        char where[512];
+        return MF_ERROR(MF_ERR_INPUT, "%s: fluid block '%s': %s",
+                        mf_loc_str(mf_dict_find(d, "fluid")->loc, where, sizeof where), name,
+                        mf_error_message());
+    }
+    const double l0 = sim->l0;
+    long lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+    for (int a = 0; a < sim->dim; a++)
+        hi[a] = lattice_count(s.min[a], s.max[a], l0);
+    size_t before = sim->p->n;
+    for (long k = lo[2]; k < hi[2]; k++)
+        for (long j = lo[1]; j < hi[1]; j++)
+            for (long i = lo[0]; i < hi[0]; i++) {
+                double x[3] = {s.min[0] + (i + 0.5) * l0, s.min[1] + (j + 0.5) * l0,
+                               sim->dim == 3 ? s.min[2] + (k + 0.5) * l0 : 0.0};
+                MF_CALL(mf_particles_add(sim->p, MF_FLUID, x, s.velocity, NULL));
+            }
+    if (fluid_field >= 0) {
+        int32_t *fid_arr = mf_particles_fi(sim->p, fluid_field);
+        for (size_t i = before; i < sim->p->n; i++)
+            fid_arr[i] = fid;
+    }
+    if (sim->p->n == before) {
+        char where[512];
+        return MF_ERROR(MF_ERR_INPUT,
+                        "%s: fluid block '%s' is smaller than one particle spacing (%g): no "
+                        "particle placed",
+                        mf_loc_str(d->loc, where, sizeof where), name, l0);
+    }
+    return 0;
+}
+
+static int parse_open_faces(const mf_dict *d, const char *name, bool open[3][2])
+{
+    static const char *const faces[] = {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
+    memset(open, 0, 6 * sizeof(bool));
+    mf_entry *e = mf_dict_find(d, "open");
+    if (!e)
+        return 0;
+    e->used = true;
+    char where[512];
+    if (e->n != 1 || e->items[0]->kind != MF_VAL_LIST)
+        return MF_ERROR(MF_ERR_INPUT, "%s: wall '%s': 'open' takes a list of faces, e.g. (ymax)",
+                        mf_loc_str(e->loc, where, sizeof where), name);
+    const mf_value *list = e->items[0];
+    for (size_t k = 0; k < list->n; k++) {
+        const mf_value *v = list->items[k];
+        int f = -1;
+        for (int q = 0; q < 6 && v->kind == MF_VAL_WORD; q++)
+            if (strcmp(v->text, faces[q]) == 0)
+                f = q;
+        if (f < 0) {
+            const char *hint = v->kind == MF_VAL_WORD ? mf_did_you_mean(v->text, faces, 6) : NULL;
+            return MF_ERROR(MF_ERR_INPUT,
+                            "%s: wall '%s': unknown face in 'open'%s%s%s; faces are xmin, xmax, "
+                            "ymin, ymax, zmin, zmax",
+                            mf_loc_str(v->loc, where, sizeof where), name,
+                            hint ? " (did you mean '" : "", hint ? hint : "", hint ? "'?)" : "");
+        }
+        open[f / 2][f % 2] = true;
+    }
+    return 0;
+}
+
+/* A lattice point k steps outside the region is in layer k: the first
+ * wallLayers are MF_WALL, the rest MF_DUMMY. */
+static int add_wall_box(mf_sim *sim, const char *name, const mf_dict *d, mf_dict *resolved)
+{
+    wall_settings s;
+    mf_dict *out = resolved ? mf_dict_set_subdict(resolved, name) : NULL;
+    MF_CALL(mf_params_apply(wall_params, 5, d, wall_extra, &s, out));
+    MF_CALL(check_box("wall", name, d, s.min, s.max, sim->dim));
+    bool open[3][2];
+    MF_CALL(parse_open_faces(d, name, open));
+    const double l0 = sim->l0;
+    const long layers = s.wall_layers + s.dummy_layers;
+    long lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1}, n[3] = {1, 1, 1};
+    for (int a = 0; a < sim->dim; a++) {
+        long h = lattice_count(s.min[a], s.max[a], l0);
+        n[a] = h;
+        lo[a] = open[a][0] ? 0 : -layers;
+        hi[a] = open[a][1] ? h : h + layers;
+    }
+    for (long k = lo[2]; k < hi[2]; k++)
+        for (long j = lo[1]; j < hi[1]; j++)
+            for (long i = lo[0]; i < hi[0]; i++) {
+                long idx[3] = {i, j, k};
+                long layer = 0; /* how many lattice steps outside the region */
+                for (int a = 0; a < sim->dim; a++) {
+                    long out_a = idx[a] < 0 ? -idx[a] : (idx[a] >= n[a] ? idx[a] - n[a] + 1 : 0);
+                    if (out_a > layer)
+                        layer = out_a;
+                }
+                if (layer == 0)
+                    continue; /* inside: that is where the fluid goes */
+                double x[3] = {s.min[0] + (i + 0.5) * l0, s.min[1] + (j + 0.5) * l0,
+                               sim->dim == 3 ? s.min[2] + (k + 0.5) * l0 : 0.0};
+                const double v0[3] = {0, 0, 0};
+                int kind = layer <= s.wall_layers ? MF_WALL : MF_DUMMY;
+                MF_CALL(mf_particles_add(sim->p, kind, x, v0, NULL));
+            }
+    return 0;
+}
+
+/* Walk a dictionary of named sub-dictionaries (blocks, walls). */
+static int for_each_named(const mf_dict *group, const char *what,
+                          int (*fn)(mf_sim *, const char *, const mf_dict *, void *), mf_sim *sim,
+                          void *ctx)
+{
+    char where[512];
+    for (size_t k = 0; group && k < group->n; k++) {
+        mf_entry *e = group->entries[k];
+        if (e->n != 1 || e->items[0]->kind != MF_VAL_DICT)
+            return MF_ERROR(MF_ERR_INPUT, "%s: %s '%s' must be a sub-dictionary { ... }",
+                            mf_loc_str(e->loc, where, sizeof where), what, e->key);
+        e->used = true;
+        MF_CALL(fn(sim, e->key, e->items[0]->dict, ctx));
+    }
+    return 0;
+}
+
+typedef struct build_ctx {
+    int fluid_field;
+    mf_dict *resolved;
+} build_ctx;
+
+static int visit_block(mf_sim *sim, const char *name, const mf_dict *d, void *ctx)
+{
+    build_ctx *c = ctx;
+    return add_fluid_block(sim, name, d, c->fluid_field, c->resolved);
+}
+
+static int visit_wall(mf_sim *sim, const char *name, const mf_dict *d, void *ctx)
+{
+    build_ctx *c = ctx;
+    return add_wall_box(sim, name, d, c->resolved);
+}
+
+int mf_scene_build(const mf_dict *geometry, double l0_override, mf_sim *sim, mf_dict *resolved)
+{
+    geometry_settings g;
+    MF_CALL(mf_params_apply(geometry_params, 4, geometry, geometry_extra, &g, NULL));
+    sim->dim = (int)g.dimension;
+    sim->l0 = l0_override > 0 ? l0_override : g.spacing;
+    if (resolved) {
+        MF_CALL(mf_dict_set_number(resolved, "dimension", (double)sim->dim));
+        MF_CALL(mf_dict_set_number(resolved, "particleSpacing", sim->l0));
+    }
+    if (!g.fluid_blocks && !g.walls) {
+        char where[512];
+        return MF_ERROR(MF_ERR_INPUT, "%s: the geometry has neither fluidBlocks nor walls",
+                        mf_loc_str(geometry->loc, where, sizeof where));
+    }
+    MF_CALL(mf_particles_create(sim->dim, 1024, &sim->p));
+    build_ctx ctx = {-1, NULL};
+    if (sim->nfluids > 1)
+        MF_CALL(mf_particles_request_field(sim->p, "FluidId", 1, MF_FIELD_INT32, true,
+                                           &ctx.fluid_field));
+    ctx.resolved = resolved ? mf_dict_set_subdict(resolved, "fluidBlocks") : NULL;
+    MF_CALL(for_each_named(g.fluid_blocks, "fluid block", visit_block, sim, &ctx));
+    ctx.resolved = resolved ? mf_dict_set_subdict(resolved, "walls") : NULL;
+    MF_CALL(for_each_named(g.walls, "wall", visit_wall, sim, &ctx));
+    return 0;
+}

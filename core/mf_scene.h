@@ -1,0 +1,36 @@
+/* mf_scene.h: build the particles of a case from constant/geometry.
+ *
+ *   dimension        2;
+ *   particleSpacing  0.005;          // l0: the one number that makes a
+ *                                    // coarse preview or a fine run
+ *   fluidBlocks { column { type box; min (0 0 0); max (0.25 0.5 0);
+ *                          fluid water; velocity (0 0 0); } }
+ *   walls       { tank   { type box; min (0 0 0); max (1 0.6 0);
+ *                          open (ymax); wallLayers 1; dummyLayers 2; } }
+ *
+ * Particles sit on the lattice min + (i + 1/2) l0 of each block, so fluid
+ * and walls built from the same corners line up. A wall box encloses the
+ * region [min, max]: its first layer (at l0/2 outside) is MF_WALL and takes
+ * part in the pressure equation, the outer layers are MF_DUMMY (number
+ * density only). Faces listed in `open` get no wall.
+ */
+#ifndef MF_SCENE_H
+#define MF_SCENE_H
+
+#include "mf_dict.h"
+#include "mf_sim.h"
+
+/* Read fluids (constant/fluids: one sub-dictionary per fluid with rho, nu,
+ * sigma) into sim->fluid. Fluids are numbered in file order. */
+int mf_scene_read_fluids(const mf_dict *fluids, mf_sim *sim);
+
+/* Build sim->p (and sim->dim, sim->l0) from the geometry dictionary.
+ * `l0_override` > 0 replaces particleSpacing (coarse preview / fine run).
+ * With more than one fluid, a "FluidId" field is created; with one, not.
+ * `resolved` (may be NULL) receives the geometry as used. */
+int mf_scene_build(const mf_dict *geometry, double l0_override, mf_sim *sim, mf_dict *resolved);
+
+/* Index of a fluid by name, or an error listing the fluids. */
+int mf_scene_fluid_index(const mf_sim *sim, const char *name, int *index);
+
+#endif

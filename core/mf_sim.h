@@ -1,0 +1,59 @@
+/* mf_sim.h: the state of a run that the modules work on.
+ *
+ * The driver owns it: it builds the particles from the case, creates the
+ * modules the case names, and advances time. Solver modules change the
+ * particles; function objects and writers only read. */
+#ifndef MF_SIM_H
+#define MF_SIM_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "mf_dict.h"
+#include "mf_log.h"
+#include "mf_neighbours.h"
+#include "mf_particles.h"
+#include "mf_registry.h"
+
+#define MF_MAX_FLUIDS 16
+
+typedef struct mf_fluid {
+    char name[64];
+    double rho;   /* density, kg/m^3 */
+    double nu;    /* kinematic viscosity, m^2/s */
+    double sigma; /* surface tension coefficient, N/m (0: none) */
+} mf_fluid;
+
+/* One created module: its table, its filled settings and its private data. */
+typedef struct mf_module {
+    const mf_module_info *info;
+    void *settings; /* info->settings_size bytes, filled from the parameter table */
+    void *data;     /* the module's own state (from create) */
+} mf_module;
+
+typedef struct mf_sim {
+    int dim;
+    double l0;                 /* particle spacing */
+    mf_particles *p;
+    int nfluids;
+    mf_fluid fluid[MF_MAX_FLUIDS];
+    /* Time. */
+    double time;
+    double end_time;
+    double dt;                 /* the step being taken (or last taken) */
+    long step;
+    /* Time-step control (system/controlDict). */
+    double max_courant;
+    double max_dt;
+    bool fixed_dt;
+    /* Modules the case names, in order. */
+    size_t nforces;
+    mf_module *forces;         /* kind MF_KIND_FORCE */
+    const mf_registry *reg;
+    mf_log *log;
+    /* Statistics the driver reports (filled by modules). */
+    double courant_mean, courant_max;
+    long pressure_iterations;  /* summed over the run */
+} mf_sim;
+
+#endif

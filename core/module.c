@@ -1,0 +1,35 @@
+/* module.c: create the settings of a module from a dictionary. */
+#include <stdlib.h>
+
+#include "mf_error.h"
+#include "mf_modules.h"
+
+int mf_module_prepare(const mf_registry *reg, mf_module_kind kind, const char *name,
+                      const mf_dict *dict, const char *const *extra_keys, mf_dict *resolved,
+                      mf_module *out)
+{
+    out->info = NULL;
+    out->settings = NULL;
+    out->data = NULL;
+    MF_CALL(mf_registry_find(reg, kind, name, &out->info));
+    out->settings = calloc(1, out->info->settings_size ? out->info->settings_size : 1);
+    if (!out->settings)
+        return MF_ERROR(MF_ERR_MEMORY, "out of memory creating module '%s'", name);
+    if (dict)
+        MF_CALL(mf_params_apply(out->info->params, out->info->nparams, dict, extra_keys,
+                                out->settings, resolved));
+    else
+        MF_CALL(mf_params_defaults(out->info->params, out->info->nparams, out->settings));
+    if (resolved && !dict) /* still record the defaults that were used */
+        MF_CALL(mf_params_apply(out->info->params, out->info->nparams, NULL, NULL, out->settings,
+                                resolved));
+    return 0;
+}
+
+void mf_module_release(mf_module *m)
+{
+    free(m->settings);
+    m->settings = NULL;
+    m->info = NULL;
+    m->data = NULL;
+}

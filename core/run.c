@@ -1,0 +1,286 @@
+/* run.c: the time loop. */
+#include "mf_run.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <time.h>
+
+#include "mf_error.h"
+#include "mf_timestep.h"
+
+double mf_wall_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+double mf_cpu_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+size_t mf_peak_memory(void)
+{
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    return (size_t)ru.ru_maxrss * 1024u; /* Linux reports KiB */
+}
+
+/* ---- a copy of the particles to go back to when a step fails ---------- */
+typedef struct saved_state {
+    size_t n, n_owned, cap;
+    double *pos, *vel;
+    uint8_t *kind;
+    int64_t *id, next_id;
+    void *field[MF_MAX_FIELDS];
+    double time;
+} saved_state;
+
+static size_t field_bytes(const mf_field *f, size_t n)
+{
+    return n * (size_t)f->ncomp * (f->type == MF_FIELD_DOUBLE ? sizeof(double) : sizeof(int32_t));
+}
+
+static int save_state(saved_state *s, const mf_particles *p, double time)
+{
+    if (s->cap < p->n) {
+        size_t cap = p->n + p->n / 4 + 16;
+        s->pos = realloc(s->pos, 3 * cap * sizeof(double));
+        s->vel = realloc(s->vel, 3 * cap * sizeof(double));
+        s->kind = realloc(s->kind, cap);
+        s->id = realloc(s->id, cap * sizeof(int64_t));
+        for (int f = 0; f < p->nfields; f++)
+            s->field[f] = realloc(s->field[f], field_bytes(&p->field[f], cap));
+        s->cap = cap;
+    }
+    for (int f = 0; f < p->nfields; f++)
+        if (!s->field[f])
+            s->field[f] = malloc(field_bytes(&p->field[f], s->cap));
+    bool ok = s->pos && s->vel && s->kind && s->id;
+    for (int f = 0; f < p->nfields; f++)
+        ok = ok && s->field[f];
+    if (!ok)
+        return MF_ERROR(MF_ERR_MEMORY, "out of memory saving the state of step");
+    s->n = p->n;
+    s->n_owned = p->n_owned;
+    s->next_id = p->next_id;
+    s->time = time;
+    memcpy(s->pos, p->pos, 3 * p->n * sizeof(double));
+    memcpy(s->vel, p->vel, 3 * p->n * sizeof(double));
+    memcpy(s->kind, p->kind, p->n);
+    memcpy(s->id, p->id, p->n * sizeof(int64_t));
+    for (int f = 0; f < p->nfields; f++)
+        memcpy(s->field[f], p->field[f].data, field_bytes(&p->field[f], p->n));
+    return 0;
+}
+
+static int restore_state(const saved_state *s, mf_particles *p)
+{
+    MF_CALL(mf_particles_reserve(p, s->n));
+    p->n = s->n;
+    p->n_owned = s->n_owned;
+    p->next_id = s->next_id;
+    memcpy(p->pos, s->pos, 3 * s->n * sizeof(double));
+    memcpy(p->vel, s->vel, 3 * s->n * sizeof(double));
+    memcpy(p->kind, s->kind, s->n);
+    memcpy(p->id, s->id, s->n * sizeof(int64_t));
+    for (int f = 0; f < p->nfields; f++)
+        if (s->field[f])
+            memcpy(p->field[f].data, s->field[f], field_bytes(&p->field[f], s->n));
+    return 0;
+}
+
+static void free_state(saved_state *s)
+{
+    free(s->pos);
+    free(s->vel);
+    free(s->kind);
+    free(s->id);
+    for (int f = 0; f < MF_MAX_FIELDS; f++)
+        free(s->field[f]);
+}
+
+/* ---- checks after each step ------------------------------------------- */
+static int check_finite(const mf_sim *sim)
+{
+    const mf_particles *p = sim->p;
+    for (size_t i = 0; i < p->n_owned; i++)
+        for (int c = 0; c < 3; c++)
+            if (!isfinite(p->pos[3 * i + c]) || !isfinite(p->vel[3 * i + c]))
+                return MF_ERROR(MF_ERR_NUMERIC,
+                                "unstable: particle id %lld (%s) has a non-finite %s at time %g "
+                                "(step %ld); the step is undone",
+                                (long long)p->id[i], mf_particle_kind_name(p->kind[i]),
+                                isfinite(p->pos[3 * i + c]) ? "velocity" : "position", sim->time,
+                                sim->step);
+    return 0;
+}
+
+/* ---- the loop ------------------------------------------------------------ */
+static double max_fluid_nu(const mf_sim *sim)
+{
+    double nu = 0;
+    for (int k = 0; k < sim->nfluids; k++)
+        if (sim->fluid[k].nu > nu)
+            nu = sim->fluid[k].nu;
+    return nu;
+}
+
+static int choose_dt(mf_run *run, double next_write, double *dt, const char **limiter)
+{
+    mf_sim *sim = run->sim;
+    const mf_run_control *c = &run->ctl;
+    if (!c->adjust) {
+        *dt = c->delta_t;
+        *limiter = "fixed";
+    } else {
+        mf_dt_choice ch;
+        mf_dt_choose(sim->l0, mf_max_fluid_speed(sim->p), c->max_co, max_fluid_nu(sim),
+                     c->max_di, c->max_delta_t, &ch);
+        *dt = ch.dt;
+        *limiter = ch.limiter;
+        /* Grow at most 20% a step from the last (OpenFOAM's damping), start at deltaT. */
+        double last = sim->step == 0 || sim->dt <= 0 ? c->delta_t : sim->dt;
+        if (*dt > 1.2 * last) {
+            *dt = 1.2 * last;
+            *limiter = "growth";
+        }
+        if (run->solver_ops->stable_dt) {
+            double sdt = INFINITY;
+            MF_CALL(run->solver_ops->stable_dt(run->solver->data, sim, &sdt));
+            if (sdt < *dt) {
+                *dt = sdt;
+                *limiter = "solver";
+            }
+        }
+        /* Land on write times and the end time (adjustableRunTime). */
+        double target = sim->end_time;
+        if (!c->write_by_steps && next_write < target)
+            target = next_write;
+        double left = target - sim->time;
+        if (left > 0 && *dt > left * (1 - 1e-9))
+            *dt = left;
+        else if (left > 0 && *dt > 0.5 * left && *dt < left)
+            *dt = 0.5 * left; /* two even steps rather than a sliver */
+    }
+    if (!(*dt > 0) || !isfinite(*dt))
+        return MF_ERROR(MF_ERR_NUMERIC, "the time step became %g at time %g", *dt, sim->time);
+    return 0;
+}
+
+static int write_now(mf_run *run)
+{
+    if (!run->writer_ops)
+        return 0;
+    MF_CALL(run->writer_ops->write(run->writer->data, run->sim, run->params));
+    for (size_t k = 0; k < run->nfunctions; k++) {
+        const mf_function_object_ops *fo = (const mf_function_object_ops *)run->functions[k].info;
+        if (fo->write)
+            MF_CALL(fo->write(run->functions[k].data, run->sim));
+    }
+    run->writes++;
+    return 0;
+}
+
+static int step_once(mf_run *run, saved_state *saved, double next_write)
+{
+    mf_sim *sim = run->sim;
+    double dt;
+    const char *limiter;
+    MF_CALL(choose_dt(run, next_write, &dt, &limiter));
+    MF_CALL(save_state(saved, sim->p, sim->time));
+    for (long attempt = 0;; attempt++) {
+        sim->dt = dt;
+        mf_courant(sim->p, dt, sim->l0, &sim->courant_mean, &sim->courant_max);
+        mf_log_printf(sim->log, MF_LOG_STEP, "Courant Number mean: %g max: %g\n",
+                      sim->courant_mean, sim->courant_max);
+        mf_log_printf(sim->log, MF_LOG_STEP, "deltaT = %g\n", dt);
+        mf_log_printf(sim->log, MF_LOG_STEP, "Time = %.10g\n\n", sim->time + dt);
+        int rc = run->solver_ops->step(run->solver->data, sim, dt);
+        if (rc == 0)
+            rc = check_finite(sim);
+        if (rc == 0)
+            break;
+        bool retry = (rc > 0 || rc == MF_ERR_NUMERIC) && attempt < run->ctl.max_retries;
+        if (!retry) {
+            MF_CALL(restore_state(saved, sim->p));
+            sim->time = saved->time;
+            return mf_error_trace(rc, __FILE__, __LINE__, __func__);
+        }
+        mf_log_printf(sim->log, MF_LOG_QUIET,
+                      "--> step at time %g failed (%s); retrying with deltaT = %g (retry %ld of "
+                      "%ld)\n",
+                      saved->time, mf_error_message(), 0.5 * dt, attempt + 1,
+                      run->ctl.max_retries);
+        mf_error_clear();
+        MF_CALL(restore_state(saved, sim->p));
+        sim->time = saved->time;
+        run->retries++;
+        dt *= 0.5;
+    }
+    (void)limiter;
+    sim->time += dt;
+    sim->step++;
+    run->steps++;
+    for (size_t k = 0; k < run->nfunctions; k++) {
+        const mf_function_object_ops *fo = (const mf_function_object_ops *)run->functions[k].info;
+        MF_CALL(fo->execute(run->functions[k].data, sim));
+    }
+    return 0;
+}
+
+int mf_run_loop(mf_run *run, bool write_initial)
+{
+    mf_sim *sim = run->sim;
+    saved_state saved;
+    memset(&saved, 0, sizeof saved);
+    const double t0 = mf_wall_seconds(), c0 = mf_cpu_seconds();
+    const double interval = run->ctl.write_interval;
+    /* Next write time: the first multiple of the interval after now. */
+    double next_write = run->ctl.write_by_steps
+                            ? (double)(sim->step + (long)interval)
+                            : interval * (floor(sim->time / interval + 1e-9) + 1);
+    int rc = 0;
+    if (write_initial)
+        MF_CALL_GOTO(rc, write_now(run), done);
+    mf_log_printf(sim->log, MF_LOG_NORMAL, "\nStarting time loop\n\n");
+    while (sim->time < sim->end_time * (1 - 1e-12)) {
+        rc = step_once(run, &saved, next_write);
+        if (rc != 0) {
+            /* Keep what we had: the state before the failed step. */
+            mf_log_printf(sim->log, MF_LOG_QUIET,
+                          "--> the run stops at time %g (step %ld); the particles are back at "
+                          "the last good state",
+                          sim->time, sim->step);
+            if (run->writer_ops) {
+                int wrc = run->writer_ops->write(run->writer->data, sim, run->params);
+                mf_log_printf(sim->log, MF_LOG_QUIET, wrc == 0 ? ", written as a snapshot.\n"
+                                                               : ", which could not be written.\n");
+            } else {
+                mf_log_printf(sim->log, MF_LOG_QUIET, ".\n");
+            }
+            goto done;
+        }
+        bool write = run->ctl.write_by_steps ? (double)sim->step >= next_write - 0.5
+                                             : sim->time >= next_write * (1 - 1e-9);
+        if (write || sim->time >= sim->end_time * (1 - 1e-12)) {
+            MF_CALL_GOTO(rc, write_now(run), done);
+            while (next_write <= (run->ctl.write_by_steps ? (double)sim->step : sim->time * (1 + 1e-9)))
+                next_write += interval;
+        }
+        double wall = mf_wall_seconds() - t0;
+        mf_log_printf(sim->log, MF_LOG_STEP, "ExecutionTime = %.3f s  ClockTime = %.0f s\n\n",
+                      mf_cpu_seconds() - c0, wall);
+        mf_log_progress(sim->log, sim->time, sim->end_time, wall);
+    }
+    mf_log_progress_end(sim->log);
+done:
+    run->wall_seconds = mf_wall_seconds() - t0;
+    free_state(&saved);
+    return rc;
+}

@@ -1,0 +1,227 @@
+/* main.c: `mpsflow`, with OpenFOAM's habits.
+ *
+ *   mpsflow [-case DIR] [-solver NAME] [-libs '(...)'] [-dryRun] [-latestTime]
+ *   mpsflow modules [NAME]
+ */
+#include <limits.h>
+#include <mpi.h>
+#include <HYPRE_utilities.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "mf_app.h"
+#include "mf_error.h"
+#include "mf_post.h"
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "Usage: mpsflow [COMMAND] [OPTIONS]\n"
+            "\n"
+            "Commands:\n"
+            "  (none)            run the case\n"
+            "  modules [NAME]    list the registered modules by kind, or the parameters of one\n"
+            "  validate          score the case's output against its reference (validation/)\n"
+            "\n"
+            "Options:\n"
+            "  -case DIR         case directory (default: the current folder)\n"
+            "  -solver NAME      solver module, overriding system/solverDict\n"
+            "  -libs '(...)'     plugin libraries to load, e.g. -libs '(libkineticEnergy.so)'\n"
+            "  -dryRun           read the case, build the scene, print a summary, stop\n"
+            "  -latestTime       restart from the newest snapshot in DIR/output\n"
+            "  -l0 VALUE         particle spacing, overriding constant/geometry (coarse/fine)\n"
+            "  -endTime VALUE    end time, overriding system/controlDict\n"
+            "  -quiet, -verbose  less or more log\n"
+            "  -help             this text\n"
+            "\n"
+            "Plugins are searched as named, then in MPSFLOW_PLUGIN_PATH, then in the\n"
+            "plugins folder beside the executable's build or install tree.\n");
+}
+
+static int parse_number(const char *opt, const char *text, double *out)
+{
+    char *end;
+    *out = strtod(text, &end);
+    if (end == text || *end || !(*out > 0))
+        return MF_ERROR(MF_ERR_INPUT, "%s takes a positive number, not '%s'", opt, text);
+    return 0;
+}
+
+/* Returns 0 and fills opt, 1 for -help, <0 on a bad option. */
+static int parse_options(int argc, char **argv, int first, mf_options *opt)
+{
+    static const char *const known[] = {"-case", "-solver", "-libs", "-dryRun", "-latestTime",
+                                        "-l0", "-endTime", "-quiet", "-verbose", "-help"};
+    for (int i = first; i < argc; i++) {
+        const char *a = argv[i];
+        bool has_value = i + 1 < argc;
+        if (!strcmp(a, "-help") || !strcmp(a, "--help") || !strcmp(a, "-h"))
+            return 1;
+        else if (!strcmp(a, "-dryRun"))
+            opt->dry_run = true;
+        else if (!strcmp(a, "-latestTime"))
+            opt->latest_time = true;
+        else if (!strcmp(a, "-quiet"))
+            opt->log_level = MF_LOG_QUIET;
+        else if (!strcmp(a, "-verbose"))
+            opt->log_level = MF_LOG_VERBOSE;
+        else if (!strcmp(a, "-case") || !strcmp(a, "-solver") || !strcmp(a, "-libs") ||
+                 !strcmp(a, "-l0") || !strcmp(a, "-endTime")) {
+            if (!has_value)
+                return MF_ERROR(MF_ERR_INPUT, "option %s needs a value (see mpsflow -help)", a);
+            const char *v = argv[++i];
+            if (!strcmp(a, "-case"))
+                opt->case_dir = v;
+            else if (!strcmp(a, "-solver"))
+                opt->solver = v;
+            else if (!strcmp(a, "-libs"))
+                opt->libs = v;
+            else if (!strcmp(a, "-l0"))
+                MF_CALL(parse_number(a, v, &opt->l0));
+            else
+                MF_CALL(parse_number(a, v, &opt->end_time));
+        } else {
+            const char *hint = mf_did_you_mean(a, known, sizeof known / sizeof known[0]);
+            return MF_ERROR(MF_ERR_INPUT, "unknown option '%s'%s%s%s (see mpsflow -help)", a,
+                            hint ? "; did you mean '" : "", hint ? hint : "", hint ? "'?" : "");
+        }
+    }
+    return 0;
+}
+
+/* Plugins built with mpsflow sit in ../plugins beside driver/ in the build
+ * tree, or in ../lib/mpsflow beside bin/ when installed. */
+static void set_plugin_dirs(mf_registry *reg)
+{
+    char exe[PATH_MAX], dirs[3 * PATH_MAX];
+    ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
+    if (n <= 0)
+        return;
+    exe[n] = '\0';
+    char *slash = strrchr(exe, '/');
+    if (!slash)
+        return;
+    *slash = '\0';
+    snprintf(dirs, sizeof dirs, "%s/../plugins:%s/../lib/mpsflow", exe, exe);
+    mf_registry_set_plugin_dir(reg, dirs);
+}
+
+int mf_cmd_modules(mf_registry *reg, const char *name)
+{
+    if (!name) {
+        mf_registry_print(reg, stdout);
+        return 0;
+    }
+    const mf_module_info *m = mf_registry_lookup_any(reg, name);
+    if (!m) {
+        /* Let the registry's error list every name of every kind. */
+        const mf_module_info *found;
+        int rc = mf_registry_find(reg, MF_KIND_SOLVER, name, &found);
+        for (int k = 1; k < MF_KIND_COUNT && rc != 0; k++) {
+            char first[2048];
+            snprintf(first, sizeof first, "%s", mf_error_message());
+            mf_error_clear();
+            rc = mf_registry_find(reg, (mf_module_kind)k, name, &found);
+            if (rc != 0) {
+                char both[4200];
+                snprintf(both, sizeof both, "%s; %s", first, mf_error_message());
+                rc = MF_ERROR(MF_ERR_INPUT, "%s", both);
+            }
+        }
+        return MF_ERROR(MF_ERR_INPUT, "no module named '%s'. %s", name, mf_error_message());
+    }
+    printf("%s (%s module): %s\n", m->name, mf_module_kind_name(m->kind), m->summary);
+    printf("Parameters:\n");
+    mf_params_print(m->params, m->nparams, stdout);
+    return 0;
+}
+
+int mf_cmd_run(mf_app *app)
+{
+    MF_CALL(mf_app_setup(app));
+    if (app->opt.dry_run) {
+        mf_app_summary(app);
+        printf("\nDry run: stopping before the time loop.\nEnd\n");
+        return 0;
+    }
+    bool restart = app->opt.latest_time || !strcmp(app->cs.control.start_from, "latestTime");
+    if (restart) {
+        const mf_writer_ops *w = (const mf_writer_ops *)app->writer.info;
+        if (!w->read_latest)
+            return MF_ERROR(MF_ERR_INPUT, "writer '%s' cannot restart a run", w->info.name);
+        MF_CALL(w->read_latest(app->writer.data, &app->sim));
+        mf_log_printf(&app->log, MF_LOG_NORMAL, "Restarting from time %g (step %ld)\n",
+                      app->sim.time, app->sim.step);
+    }
+    MF_CALL(mf_case_write_resolved(&app->cs));
+    mf_app_summary(app);
+    int rc = mf_run_loop(&app->run, !restart);
+    mf_log_printf(&app->log, MF_LOG_QUIET,
+                  "\nSteps %ld (retried %ld), snapshots %d, wall time %.2f s, peak memory %.1f "
+                  "MB\n",
+                  app->run.steps, app->run.retries, app->run.writes, app->run.wall_seconds,
+                  mf_peak_memory() / 1048576.0);
+    MF_CALL(rc);
+    mf_log_printf(&app->log, MF_LOG_QUIET, "End\n");
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    mf_app app;
+    memset(&app, 0, sizeof app);
+    app.opt.case_dir = ".";
+    app.opt.log_level = MF_LOG_NORMAL;
+    const char *command = NULL;
+    int first = 1;
+    if (argc > 1 && argv[1][0] != '-') {
+        command = argv[1];
+        first = 2;
+    }
+    const char *module_name = NULL;
+    if (command && !strcmp(command, "modules") && argc > 2 && argv[2][0] != '-') {
+        module_name = argv[2];
+        first = 3;
+    }
+    int rc = parse_options(argc, argv, first, &app.opt);
+    if (rc == 1) {
+        usage(stdout);
+        return 0;
+    }
+    if (rc != 0) {
+        mf_error_print(stderr);
+        return 2;
+    }
+    if (command && strcmp(command, "modules") != 0 && strcmp(command, "validate") != 0) {
+        static const char *const commands[] = {"modules", "validate"};
+        const char *hint = mf_did_you_mean(command, commands, 2);
+        fprintf(stderr, "mpsflow: unknown command '%s'%s%s%s\n\n", command,
+                hint ? " (did you mean '" : "", hint ? hint : "", hint ? "'?)" : "");
+        usage(stderr);
+        return 2;
+    }
+    MPI_Init(&argc, &argv);
+    HYPRE_Init();
+    rc = mf_registry_create(&app.reg);
+    if (rc == 0) {
+        set_plugin_dirs(app.reg);
+        rc = mf_register_builtins(app.reg);
+    }
+    if (rc == 0 && app.opt.libs)
+        rc = mf_app_load_libs_text(app.reg, app.opt.libs);
+    double error = 0;
+    if (rc == 0 && !command)
+        rc = mf_cmd_run(&app);
+    else if (rc == 0 && !strcmp(command, "modules"))
+        rc = mf_cmd_modules(app.reg, module_name);
+    else if (rc == 0)
+        rc = mf_cmd_validate(app.opt.case_dir, &error);
+    if (rc != 0)
+        mf_error_print(stderr);
+    mf_app_teardown(&app);
+    mf_registry_destroy(app.reg);
+    HYPRE_Finalize();
+    MPI_Finalize();
+    return rc == 0 ? 0 : 1;
+}

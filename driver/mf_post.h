@@ -1,0 +1,33 @@
+/* mf_post.h: post-processing commands (validate) and their helpers. */
+#ifndef MF_POST_H
+#define MF_POST_H
+
+#include <stddef.h>
+
+#include "mf_dict.h"
+#include "mf_sim.h"
+
+/* Indices of the case's snapshots, ascending. Free *indices. */
+int mf_list_snapshots(const char *case_dir, int **indices, size_t *n);
+void mf_snapshot_path(const char *case_dir, int index, char *path, size_t len);
+
+/* A validation metric: reads the case's output, writes
+ * validation/result.csv and result.png, returns the error. */
+typedef struct mf_metric {
+    const char *name;
+    const char *summary;
+    int (*evaluate)(const char *case_dir, const mf_dict *metric_dict, double *error);
+} mf_metric;
+
+extern const mf_metric mf_metric_surge_front;
+extern const mf_metric mf_metric_hydrostatic;
+
+/* `mpsflow validate -case DIR`: prints "error <metric> = <value>". */
+int mf_cmd_validate(const char *case_dir, double *error);
+
+/* Linear interpolation of y(x) at xq on ascending x; NAN outside. */
+double mf_interp(const double *x, const double *y, size_t n, double xq);
+/* Read a two-column CSV with '#' comments and one header line. */
+int mf_read_csv2(const char *path, double **a, double **b, size_t *n);
+
+#endif

@@ -1,0 +1,280 @@
+/* setup.c: wire a case to the modules it names. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "mf_app.h"
+#include "mf_dictio.h"
+#include "mf_error.h"
+#include "mf_scene.h"
+
+int mf_app_load_libs_text(mf_registry *reg, const char *text)
+{
+    char buf[8192];
+    snprintf(buf, sizeof buf, "libs %s;", text);
+    mf_dict *d = NULL;
+    MF_CALL(mf_dict_parse_string(buf, strlen(buf), "-libs", &d));
+    mf_entry *e = mf_dict_find(d, "libs");
+    int rc = 0;
+    if (!e || e->n != 1 || e->items[0]->kind != MF_VAL_LIST) {
+        rc = MF_ERROR(MF_ERR_INPUT, "-libs takes a list, e.g. -libs '(libkineticEnergy.so)'");
+    } else {
+        for (size_t k = 0; k < e->items[0]->n && rc == 0; k++)
+            rc = mf_registry_load_plugin(reg, e->items[0]->items[k]->text);
+    }
+    mf_dict_free(d);
+    return rc;
+}
+
+static int load_case_libs(mf_app *app)
+{
+    const char **libs = NULL;
+    size_t n = 0;
+    MF_CALL(mf_case_libs(&app->cs, &libs, &n));
+    int rc = 0;
+    for (size_t k = 0; k < n && rc == 0; k++)
+        rc = mf_registry_load_plugin(app->reg, libs[k]);
+    free(libs);
+    return rc;
+}
+
+/* forces { gravity { g (0 -9.81 0); } myDrag { type drag; ... } } */
+static int create_forces(mf_app *app, mf_dict *resolved)
+{
+    const mf_dict *forces = mf_dict_subdict(app->cs.solver_dict, "forces");
+    if (!forces)
+        return 0;
+    mf_sim *sim = &app->sim;
+    sim->forces = calloc(forces->n ? forces->n : 1, sizeof *sim->forces);
+    if (!sim->forces)
+        return MF_ERROR(MF_ERR_MEMORY, "out of memory");
+    mf_dict *rforces = mf_dict_set_subdict(resolved, "forces");
+    static const char *const extra[] = {"type", NULL};
+    char where[512];
+    for (size_t k = 0; k < forces->n; k++) {
+        mf_entry *e = forces->entries[k];
+        if (e->n != 1 || e->items[0]->kind != MF_VAL_DICT)
+            return MF_ERROR(MF_ERR_INPUT, "%s: force '%s' must be a sub-dictionary { ... }",
+                            mf_loc_str(e->loc, where, sizeof where), e->key);
+        const mf_dict *fd = e->items[0]->dict;
+        const char *type = e->key;
+        MF_CALL(mf_dict_get_word_or(fd, "type", e->key, &type));
+        mf_dict *rf = mf_dict_set_subdict(rforces, e->key);
+        MF_CALL(mf_dict_set_word(rf, "type", type));
+        mf_module *m = &sim->forces[sim->nforces];
+        int rc = mf_module_prepare(app->reg, MF_KIND_FORCE, type, fd, extra, rf, m);
+        if (rc != 0)
+            return MF_ERROR(rc, "%s: force '%s': %s", mf_loc_str(e->loc, where, sizeof where),
+                            e->key, mf_error_message());
+        sim->nforces++;
+        const mf_force_ops *ops = (const mf_force_ops *)m->info;
+        MF_CALL(ops->create(m->settings, sim, &m->data));
+    }
+    return 0;
+}
+
+static int create_solver(mf_app *app, mf_dict *resolved)
+{
+    const mf_dict *sd = app->cs.solver_dict;
+    const char *name = app->opt.solver;
+    if (!name)
+        MF_CALL(mf_dict_get_word(sd, "solver", &name));
+    else if (mf_dict_find(sd, "solver"))
+        mf_dict_find(sd, "solver")->used = true;
+    /* Allowed top-level keys: solver, <name>Coeffs of any solver, pressure, forces. */
+    char coeffs[256];
+    snprintf(coeffs, sizeof coeffs, "%sCoeffs", name);
+    const mf_module_info *info = NULL;
+    MF_CALL(mf_registry_find(app->reg, MF_KIND_SOLVER, name, &info));
+    size_t ns = mf_registry_count(app->reg, MF_KIND_SOLVER);
+    char(*names)[256] = calloc(ns + 1, sizeof *names);
+    const char **extra = calloc(ns + 6, sizeof *extra);
+    if (!names || !extra) {
+        free(names);
+        free(extra);
+        return MF_ERROR(MF_ERR_MEMORY, "out of memory");
+    }
+    size_t ne = 0;
+    extra[ne++] = "solver";
+    extra[ne++] = "pressure";
+    extra[ne++] = "forces";
+    extra[ne++] = "FoamFile";
+    for (size_t k = 0; k < ns; k++) {
+        snprintf(names[k], sizeof names[k], "%sCoeffs", mf_registry_at(app->reg, MF_KIND_SOLVER, k)->name);
+        extra[ne++] = names[k];
+    }
+    extra[ne] = NULL;
+    int rc = mf_params_apply(NULL, 0, sd, extra, NULL, NULL);
+    free(names);
+    free(extra);
+    MF_CALL(rc);
+    mf_dict *rs = mf_dict_set_subdict(resolved, "solverDict");
+    MF_CALL(mf_dict_set_word(rs, "solver", name));
+    MF_CALL(mf_module_prepare(app->reg, MF_KIND_SOLVER, name, mf_dict_subdict(sd, coeffs), NULL,
+                              mf_dict_set_subdict(rs, coeffs), &app->solver));
+    MF_CALL(create_forces(app, rs));
+    const mf_solver_ops *ops = (const mf_solver_ops *)app->solver.info;
+    /* The solver reads `pressure` itself; it records what it used in rs. */
+    MF_CALL(ops->create(app->solver.settings, &app->sim, sd, &app->solver.data));
+    const mf_dict *pd = mf_dict_subdict(sd, "pressure");
+    if (pd) {
+        mf_dict *rp = mf_dict_set_subdict(rs, "pressure");
+        for (size_t k = 0; k < pd->n; k++) {
+            mf_entry *e = pd->entries[k];
+            mf_value **items = calloc(e->n ? e->n : 1, sizeof *items);
+            if (!items)
+                return MF_ERROR(MF_ERR_MEMORY, "out of memory");
+            for (size_t i = 0; i < e->n; i++)
+                items[i] = mf_value_copy(e->items[i], rp);
+            mf_dict_set(rp, e->key, e->loc, e->n, items);
+        }
+    }
+    return 0;
+}
+
+/* functions { ke { type kineticEnergy; libs ("libkineticEnergy.so"); ... } } */
+static int create_functions(mf_app *app, mf_dict *resolved)
+{
+    const mf_dict *fns = mf_dict_subdict(app->cs.control_dict, "functions");
+    if (!fns)
+        return 0;
+    mf_dict_find(app->cs.control_dict, "functions")->used = true;
+    app->functions = calloc(fns->n ? fns->n : 1, sizeof *app->functions);
+    if (!app->functions)
+        return MF_ERROR(MF_ERR_MEMORY, "out of memory");
+    mf_dict *rfns = mf_dict_set_subdict(resolved, "functions");
+    static const char *const extra[] = {"type", "libs", NULL};
+    char where[512], out_dir[4400];
+    for (size_t k = 0; k < fns->n; k++) {
+        mf_entry *e = fns->entries[k];
+        if (e->n != 1 || e->items[0]->kind != MF_VAL_DICT)
+            return MF_ERROR(MF_ERR_INPUT, "%s: function '%s' must be a sub-dictionary { type ...; }",
+                            mf_loc_str(e->loc, where, sizeof where), e->key);
+        const mf_dict *fd = e->items[0]->dict;
+        mf_entry *libs = mf_dict_find(fd, "libs");
+        if (libs) {
+            libs->used = true;
+            for (size_t i = 0; libs->n == 1 && libs->items[0]->kind == MF_VAL_LIST &&
+                               i < libs->items[0]->n;
+                 i++)
+                MF_CALL(mf_registry_load_plugin(app->reg, libs->items[0]->items[i]->text));
+        }
+        const char *type;
+        MF_CALL(mf_dict_get_word(fd, "type", &type));
+        mf_dict *rf = mf_dict_set_subdict(rfns, e->key);
+        MF_CALL(mf_dict_set_word(rf, "type", type));
+        mf_module *m = &app->functions[app->nfunctions];
+        int rc = mf_module_prepare(app->reg, MF_KIND_FUNCTION_OBJECT, type, fd, extra, rf, m);
+        if (rc != 0)
+            return MF_ERROR(rc, "%s: function '%s': %s", mf_loc_str(e->loc, where, sizeof where),
+                            e->key, mf_error_message());
+        app->nfunctions++;
+        snprintf(out_dir, sizeof out_dir, "%s/postProcessing/%s", app->cs.dir, e->key);
+        const mf_function_object_ops *ops = (const mf_function_object_ops *)m->info;
+        MF_CALL(ops->create(m->settings, &app->sim, out_dir, &m->data));
+    }
+    return 0;
+}
+
+static int create_writer(mf_app *app, mf_dict *resolved)
+{
+    const mf_dict *wd = mf_dict_subdict(app->cs.control_dict, "writerCoeffs");
+    MF_CALL(mf_module_prepare(app->reg, MF_KIND_WRITER, app->cs.control.writer, wd, NULL,
+                              mf_dict_set_subdict(resolved, "writerCoeffs"), &app->writer));
+    const mf_writer_ops *ops = (const mf_writer_ops *)app->writer.info;
+    MF_CALL(ops->create(app->writer.settings, app->cs.dir, &app->writer.data));
+    return 0;
+}
+
+int mf_app_setup(mf_app *app)
+{
+    mf_sim *sim = &app->sim;
+    mf_log_init(&app->log, stdout, app->opt.log_level);
+    sim->log = &app->log;
+    sim->reg = app->reg;
+    MF_CALL(mf_case_read(app->opt.case_dir, &app->cs));
+    MF_CALL(load_case_libs(app));
+    const mf_control *c = &app->cs.control;
+    sim->time = c->start_time;
+    sim->end_time = app->opt.end_time > 0 ? app->opt.end_time : c->end_time;
+    sim->max_courant = c->max_co;
+    sim->max_dt = c->max_delta_t;
+    sim->fixed_dt = !c->adjust_time_step;
+    MF_CALL(mf_scene_read_fluids(app->cs.fluids, sim));
+    mf_dict *resolved = app->cs.resolved;
+    MF_CALL(mf_scene_build(app->cs.geometry, app->opt.l0, sim,
+                           mf_dict_set_subdict(resolved, "geometry")));
+    mf_dict *rf = mf_dict_set_subdict(resolved, "fluids");
+    for (int k = 0; k < sim->nfluids; k++) {
+        mf_dict *f = mf_dict_set_subdict(rf, sim->fluid[k].name);
+        MF_CALL(mf_dict_set_number(f, "rho", sim->fluid[k].rho));
+        MF_CALL(mf_dict_set_number(f, "nu", sim->fluid[k].nu));
+        MF_CALL(mf_dict_set_number(f, "sigma", sim->fluid[k].sigma));
+    }
+    MF_CALL(create_solver(app, resolved));
+    MF_CALL(create_functions(app, resolved));
+    MF_CALL(create_writer(app, resolved));
+
+    mf_run *run = &app->run;
+    run->sim = sim;
+    run->ctl.delta_t = c->delta_t;
+    run->ctl.adjust = c->adjust_time_step;
+    run->ctl.max_co = c->max_co;
+    run->ctl.max_di = c->max_di;
+    run->ctl.max_delta_t = c->max_delta_t;
+    run->ctl.write_by_steps = strcmp(c->write_control, "timeStep") == 0;
+    run->ctl.write_interval = c->write_interval;
+    run->ctl.max_retries = c->max_retries;
+    run->solver_ops = (const mf_solver_ops *)app->solver.info;
+    run->solver = &app->solver;
+    run->writer_ops = (const mf_writer_ops *)app->writer.info;
+    run->writer = &app->writer;
+    run->nfunctions = app->nfunctions;
+    run->functions = app->functions;
+    run->params = resolved;
+    return 0;
+}
+
+void mf_app_teardown(mf_app *app)
+{
+    for (size_t k = 0; k < app->nfunctions; k++) {
+        const mf_function_object_ops *ops = (const mf_function_object_ops *)app->functions[k].info;
+        if (app->functions[k].data)
+            ops->destroy(app->functions[k].data);
+        mf_module_release(&app->functions[k]);
+    }
+    free(app->functions);
+    if (app->writer.info && app->writer.data)
+        ((const mf_writer_ops *)app->writer.info)->destroy(app->writer.data);
+    mf_module_release(&app->writer);
+    if (app->solver.info && app->solver.data)
+        ((const mf_solver_ops *)app->solver.info)->destroy(app->solver.data);
+    mf_module_release(&app->solver);
+    for (size_t k = 0; k < app->sim.nforces; k++) {
+        const mf_force_ops *ops = (const mf_force_ops *)app->sim.forces[k].info;
+        if (app->sim.forces[k].data)
+            ops->destroy(app->sim.forces[k].data);
+        mf_module_release(&app->sim.forces[k]);
+    }
+    free(app->sim.forces);
+    mf_particles_destroy(app->sim.p);
+    mf_case_free(&app->cs);
+}
+
+void mf_app_summary(const mf_app *app)
+{
+    const mf_sim *sim = &app->sim;
+    size_t counts[MF_NKINDS];
+    mf_particles_count_kinds(sim->p, counts);
+    printf("\nCase %s: %d-D, particle spacing l0 = %g m\n", app->cs.dir, sim->dim, sim->l0);
+    printf("Particles: %zu in all\n", sim->p->n);
+    for (int k = 0; k < MF_NKINDS; k++)
+        if (counts[k])
+            printf("    %-8s %zu\n", mf_particle_kind_name(k), counts[k]);
+    printf("Fluids:\n");
+    for (int k = 0; k < sim->nfluids; k++)
+        printf("    %-12s rho = %g kg/m^3, nu = %g m^2/s, sigma = %g N/m\n", sim->fluid[k].name,
+               sim->fluid[k].rho, sim->fluid[k].nu, sim->fluid[k].sigma);
+    printf("Solver %s; time %g to %g s\n", app->solver.info->name, sim->time, sim->end_time);
+    printf("Memory: particles %.2f MB; peak resident %.1f MB\n",
+           mf_particles_memory(sim->p) / 1048576.0, mf_peak_memory() / 1048576.0);
+}

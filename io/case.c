@@ -1,0 +1,145 @@
+/* case.c: the case reader. */
+#include "mf_case.h"
+
+#include <errno.h>
+#include <stddef.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "mf_dictio.h"
+#include "mf_error.h"
+#include "mf_params.h"
+
+static const char *const write_controls[] = {"adjustableRunTime", "timeStep", NULL};
+static const char *const start_froms[] = {"startTime", "latestTime", NULL};
+
+const mf_param mf_control_params[] = {
+    {"application", MF_PARAM_WORD, "mpsflow", MF_NO_RANGE, NULL, offsetof(mf_control, application),
+     "informational, as in OpenFOAM"},
+    {"startTime", MF_PARAM_SCALAR, "0", 0, 1e30, NULL, offsetof(mf_control, start_time),
+     "time of the initial state, s"},
+    {"endTime", MF_PARAM_SCALAR, NULL, 0, 1e30, NULL, offsetof(mf_control, end_time),
+     "time to stop, s"},
+    {"deltaT", MF_PARAM_SCALAR, "1e-4", 1e-15, 1e6, NULL, offsetof(mf_control, delta_t),
+     "first time step (every step when adjustTimeStep is off), s"},
+    {"adjustTimeStep", MF_PARAM_BOOL, "yes", MF_NO_RANGE, NULL,
+     offsetof(mf_control, adjust_time_step), "choose dt from the Courant and viscous limits"},
+    {"maxCo", MF_PARAM_SCALAR, "0.2", 1e-6, 100, NULL, offsetof(mf_control, max_co),
+     "largest Courant number |u| dt / l0"},
+    {"maxDi", MF_PARAM_SCALAR, "0.1", 0, 100, NULL, offsetof(mf_control, max_di),
+     "largest viscous number nu dt / l0^2 (0: no viscous limit)"},
+    {"maxDeltaT", MF_PARAM_SCALAR, "1", 1e-15, 1e30, NULL, offsetof(mf_control, max_delta_t),
+     "largest time step, s"},
+    {"writeControl", MF_PARAM_WORD, "adjustableRunTime", MF_NO_RANGE, write_controls,
+     offsetof(mf_control, write_control), "writeInterval in seconds or in steps"},
+    {"writeInterval", MF_PARAM_SCALAR, NULL, 1e-15, 1e30, NULL,
+     offsetof(mf_control, write_interval), "time (or steps) between snapshots"},
+    {"writer", MF_PARAM_WORD, "hdf5", MF_NO_RANGE, NULL, offsetof(mf_control, writer),
+     "writer module for snapshots"},
+    {"startFrom", MF_PARAM_WORD, "startTime", MF_NO_RANGE, start_froms,
+     offsetof(mf_control, start_from), "latestTime restarts from the newest snapshot"},
+    {"maxRetries", MF_PARAM_INT, "4", 0, 20, NULL, offsetof(mf_control, max_retries),
+     "retries of a failed step, each with half the time step"},
+};
+const size_t mf_control_nparams = sizeof mf_control_params / sizeof mf_control_params[0];
+
+static int read_one(const char *dir, const char *rel, mf_dict **out)
+{
+    char path[4400];
+    snprintf(path, sizeof path, "%s/%s", dir, rel);
+    struct stat st;
+    if (stat(path, &st) != 0)
+        return MF_ERROR(MF_ERR_INPUT, "%s: cannot open (%s); is '%s' a case directory?", path,
+                        strerror(errno), dir);
+    MF_CALL(mf_dict_parse_file(path, out));
+    return 0;
+}
+
+int mf_case_read(const char *dir, mf_case *c)
+{
+    memset(c, 0, sizeof *c);
+    if (strlen(dir) >= sizeof c->dir)
+        return MF_ERROR(MF_ERR_INPUT, "case path too long");
+    snprintf(c->dir, sizeof c->dir, "%s", dir);
+    MF_CALL(read_one(dir, "system/controlDict", &c->control_dict));
+    MF_CALL(read_one(dir, "system/solverDict", &c->solver_dict));
+    MF_CALL(read_one(dir, "constant/fluids", &c->fluids));
+    MF_CALL(read_one(dir, "constant/geometry", &c->geometry));
+    c->resolved = mf_dict_new("", NULL);
+    if (!c->resolved)
+        return MF_ERROR(MF_ERR_MEMORY, "out of memory");
+    static const char *const extra[] = {"FoamFile", "libs", "functions", NULL};
+    MF_CALL(mf_params_apply(mf_control_params, mf_control_nparams, c->control_dict, extra,
+                            &c->control, mf_dict_set_subdict(c->resolved, "controlDict")));
+    if (c->control.end_time <= c->control.start_time) {
+        char where[512];
+        const mf_entry *e = mf_dict_find(c->control_dict, "endTime");
+        return MF_ERROR(MF_ERR_INPUT, "%s: endTime (%g) must be after startTime (%g)",
+                        mf_loc_str(e->loc, where, sizeof where), c->control.end_time,
+                        c->control.start_time);
+    }
+    return 0;
+}
+
+void mf_case_free(mf_case *c)
+{
+    mf_dict_free(c->control_dict);
+    mf_dict_free(c->solver_dict);
+    mf_dict_free(c->fluids);
+    mf_dict_free(c->geometry);
+    mf_dict_free(c->resolved);
+    memset(c, 0, sizeof *c);
+}
+
+int mf_case_libs(const mf_case *c, const char ***libs, size_t *n)
+{
+    *libs = NULL;
+    *n = 0;
+    mf_entry *e = mf_dict_find(c->control_dict, "libs");
+    if (!e)
+        return 0;
+    e->used = true;
+    char where[512];
+    if (e->n != 1 || e->items[0]->kind != MF_VAL_LIST)
+        return MF_ERROR(MF_ERR_INPUT, "%s: 'libs' takes a list, e.g. libs (\"libprobes.so\");",
+                        mf_loc_str(e->loc, where, sizeof where));
+    const mf_value *list = e->items[0];
+    *libs = calloc(list->n + 1, sizeof **libs);
+    if (!*libs)
+        return MF_ERROR(MF_ERR_MEMORY, "out of memory");
+    for (size_t k = 0; k < list->n; k++) {
+        const mf_value *v = list->items[k];
+        if (v->kind != MF_VAL_WORD && v->kind != MF_VAL_STRING) {
+            free(*libs);
+            *libs = NULL;
+            return MF_ERROR(MF_ERR_INPUT, "%s: 'libs' entries are library names",
+                            mf_loc_str(v->loc, where, sizeof where));
+        }
+        (*libs)[k] = v->text;
+    }
+    *n = list->n;
+    return 0;
+}
+
+int mf_case_write_resolved(const mf_case *c)
+{
+    char dir[4200], path[4300], tmp[4400];
+    snprintf(dir, sizeof dir, "%s/output", c->dir);
+    if (mkdir(dir, 0777) != 0 && errno != EEXIST)
+        return MF_ERROR(MF_ERR_IO, "%s: cannot create (%s)", dir, strerror(errno));
+    snprintf(path, sizeof path, "%s/resolvedParameters", dir);
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    FILE *f = fopen(tmp, "w");
+    if (!f)
+        return MF_ERROR(MF_ERR_IO, "%s: cannot write (%s)", tmp, strerror(errno));
+    fprintf(f, "// Parameters of this run as used, defaults included (written by mpsflow "
+               "%s).\n\n",
+            MPSFLOW_VERSION);
+    int rc = mf_dict_write(c->resolved, f, 0);
+    if (fclose(f) != 0 && rc == 0)
+        rc = MF_ERROR(MF_ERR_IO, "%s: write failed (%s)", tmp, strerror(errno));
+    if (rc == 0 && rename(tmp, path) != 0)
+        rc = MF_ERROR(MF_ERR_IO, "%s: cannot rename (%s)", path, strerror(errno));
+    return rc;
+}

@@ -1,0 +1,290 @@
+/* hdf5_writer.c: write one snapshot file (layout in mf_hdf5.h).
+ *
+ * The file is written as "<path>.tmp", closed, synced and renamed: the real
+ * name only ever holds a complete file. Particles are grouped by kind in
+ * storage order; StorageIndex records where each came from. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "hdf5_internal.h"
+#include "mf_error.h"
+#include "mf_hdf5.h"
+
+/* Rows per chunk when compressing: 16k rows of 3 doubles is 384 KiB, inside
+ * HDF5's default 1 MiB chunk cache. */
+#define CHUNK_ROWS 16384
+
+typedef struct snap_writer {
+    const char *path;   /* the final name, for messages */
+    hid_t file;
+    int compression;
+    const mf_particles *p;
+    size_t *index;      /* particles of the kind being written */
+    size_t count;
+    void *buf;          /* gather buffer: count * max components * 8 bytes */
+} snap_writer;
+
+static int write_header(const snap_writer *w, const mf_sim *sim,
+                        const int64_t counts[MF_NKINDS])
+{
+    char what[MF_H5_PATH_MAX], detail[256];
+    snprintf(what, sizeof what, "%s:/Header", w->path);
+    hid_t g = H5Gcreate2(w->file, "Header", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    if (g < 0)
+        return MF_ERROR(MF_ERR_IO, "%s: cannot create the group (%s)", what,
+                        mf_h5_error_detail(detail, sizeof detail));
+    const int64_t step = sim->step, next_id = w->p->next_id;
+    const int dim = w->p->dim, one = 1;
+    int rc = 0;
+    MF_CALL_GOTO(rc, mf_h5_attr_write(g, "Time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 0, &sim->time, what), done);
+    MF_CALL_GOTO(rc, mf_h5_attr_write(g, "Step", H5T_STD_I64LE, H5T_NATIVE_INT64, 0, &step, what), done);
+    MF_CALL_GOTO(rc, mf_h5_attr_write(g, "TimeStep", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 0, &sim->dt, what), done);
+    MF_CALL_GOTO(rc, mf_h5_attr_write(g, "Dimension", H5T_STD_I32LE, H5T_NATIVE_INT, 0, &dim, what), done);
+    MF_CALL_GOTO(rc, mf_h5_attr_write(g, "ParticleSpacing", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 0, &sim->l0, what), done);
+    MF_CALL_GOTO(rc, mf_h5_attr_write(g, "NumPart_ThisFile", H5T_STD_I64LE, H5T_NATIVE_INT64, MF_NKINDS, counts, what), done);
+    /* One file per snapshot (and one rank) for now: the totals are the same. */
+    MF_CALL_GOTO(rc, mf_h5_attr_write(g, "NumPart_Total", H5T_STD_I64LE, H5T_NATIVE_INT64, MF_NKINDS, counts, what), done);
+    MF_CALL_GOTO(rc, mf_h5_attr_write(g, "NextId", H5T_STD_I64LE, H5T_NATIVE_INT64, 0, &next_id, what), done);
+    MF_CALL_GOTO(rc, mf_h5_attr_write(g, "NumFilesPerSnapshot", H5T_STD_I32LE, H5T_NATIVE_INT, 0, &one, what), done);
+    /* Every snapshot holds what a restart needs (StorageIndex, all output
+     * fields), so each one can be restarted from. */
+    MF_CALL_GOTO(rc, mf_h5_attr_write(g, "Flag_Restart", H5T_STD_I32LE, H5T_NATIVE_INT, 0, &one, what), done);
+    MF_CALL_GOTO(rc, mf_h5_attr_write_string(g, "Code", "mpsflow", what), done);
+    MF_CALL_GOTO(rc, mf_h5_attr_write_string(g, "CodeVersion", MPSFLOW_VERSION, what), done);
+done:
+    H5Gclose(g);
+    return rc;
+}
+
+static int write_parameters(const snap_writer *w, const mf_dict *params)
+{
+    char what[MF_H5_PATH_MAX], detail[256];
+    snprintf(what, sizeof what, "%s:/Parameters", w->path);
+    hid_t g = H5Gcreate2(w->file, "Parameters", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    if (g < 0)
+        return MF_ERROR(MF_ERR_IO, "%s: cannot create the group (%s)", what,
+                        mf_h5_error_detail(detail, sizeof detail));
+    int rc = mf_h5_write_dict(g, params, what);
+    H5Gclose(g);
+    MF_CALL(rc);
+    return 0;
+}
+
+/* One dataset of w->count rows and ncomp columns (rank 1 when ncomp == 1)
+ * from the gathered buffer. */
+static int write_dataset(const snap_writer *w, hid_t group, const char *group_name,
+                         const char *name, int ncomp, hid_t file_type, hid_t mem_type)
+{
+    char what[MF_H5_PATH_MAX], detail[256];
+    snprintf(what, sizeof what, "%s:/%s/%s", w->path, group_name, name);
+    hsize_t dims[2] = {w->count, (hsize_t)ncomp};
+    int rank = ncomp == 1 ? 1 : 2;
+    hid_t space = H5Screate_simple(rank, dims, NULL);
+    hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
+    hid_t dset = H5I_INVALID_HID;
+    int rc = 0;
+    if (space < 0 || dcpl < 0) {
+        rc = MF_ERROR(MF_ERR_IO, "%s: cannot create the dataspace (%s)", what,
+                      mf_h5_error_detail(detail, sizeof detail));
+        goto done;
+    }
+    if (w->compression > 0) {
+        hsize_t chunk[2] = {w->count < CHUNK_ROWS ? w->count : CHUNK_ROWS, (hsize_t)ncomp};
+        /* Shuffle groups the bytes of equal significance: gzip then finds
+         * the repeated exponents of neighbouring doubles. Both lossless. */
+        if (H5Pset_chunk(dcpl, rank, chunk) < 0 || H5Pset_shuffle(dcpl) < 0 ||
+            H5Pset_deflate(dcpl, (unsigned)w->compression) < 0) {
+            rc = MF_ERROR(MF_ERR_IO, "%s: cannot set up compression (%s)", what,
+                          mf_h5_error_detail(detail, sizeof detail));
+            goto done;
+        }
+    }
+    dset = H5Dcreate2(group, name, file_type, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+    if (dset < 0 || H5Dwrite(dset, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, w->buf) < 0) {
+        rc = MF_ERROR(MF_ERR_IO, "%s: cannot write the dataset (%s)", what,
+                      mf_h5_error_detail(detail, sizeof detail));
+        goto done;
+    }
+    rc = mf_h5_attr_write_string(dset, "Units", mf_h5_unit(name), what);
+done:
+    mf_h5_close(&dset);
+    mf_h5_close(&dcpl);
+    mf_h5_close(&space);
+    return rc;
+}
+
+static void gather_double(const snap_writer *w, const double *src, int ncomp)
+{
+    double *dst = w->buf;
+    for (size_t k = 0; k < w->count; k++)
+        memcpy(dst + k * (size_t)ncomp, src + w->index[k] * (size_t)ncomp,
+               (size_t)ncomp * sizeof *dst);
+}
+
+static void gather_int32(const snap_writer *w, const int32_t *src, int ncomp)
+{
+    int32_t *dst = w->buf;
+    for (size_t k = 0; k < w->count; k++)
+        memcpy(dst + k * (size_t)ncomp, src + w->index[k] * (size_t)ncomp,
+               (size_t)ncomp * sizeof *dst);
+}
+
+static int write_kind(snap_writer *w, int kind)
+{
+    char group_name[32], what[MF_H5_PATH_MAX], detail[256];
+    const mf_particles *p = w->p;
+    mf_h5_part_group(kind, group_name, sizeof group_name);
+    snprintf(what, sizeof what, "%s:/%s", w->path, group_name);
+
+    w->count = 0;
+    for (size_t i = 0; i < p->n_owned; i++)
+        if (p->kind[i] == kind)
+            w->index[w->count++] = i;
+
+    hid_t g = H5Gcreate2(w->file, group_name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    if (g < 0)
+        return MF_ERROR(MF_ERR_IO, "%s: cannot create the group (%s)", what,
+                        mf_h5_error_detail(detail, sizeof detail));
+    int rc = 0;
+    MF_CALL_GOTO(rc, mf_h5_attr_write_string(g, "KindName", mf_h5_kind_name(kind), what), done);
+
+    gather_double(w, p->pos, 3);
+    MF_CALL_GOTO(rc, write_dataset(w, g, group_name, "Coordinates", 3, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE), done);
+    gather_double(w, p->vel, 3);
+    MF_CALL_GOTO(rc, write_dataset(w, g, group_name, "Velocities", 3, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE), done);
+    int64_t *ids = w->buf;
+    for (size_t k = 0; k < w->count; k++)
+        ids[k] = p->id[w->index[k]];
+    MF_CALL_GOTO(rc, write_dataset(w, g, group_name, "ParticleIDs", 1, H5T_STD_I64LE, H5T_NATIVE_INT64), done);
+    for (size_t k = 0; k < w->count; k++)
+        ids[k] = (int64_t)w->index[k];
+    MF_CALL_GOTO(rc, write_dataset(w, g, group_name, "StorageIndex", 1, H5T_STD_I64LE, H5T_NATIVE_INT64), done);
+
+    for (int f = 0; f < p->nfields; f++) {
+        const mf_field *field = &p->field[f];
+        if (!field->output)
+            continue;
+        if (field->type == MF_FIELD_DOUBLE) {
+            gather_double(w, field->data, field->ncomp);
+            MF_CALL_GOTO(rc, write_dataset(w, g, group_name, field->name, field->ncomp,
+                                           H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE), done);
+        } else {
+            gather_int32(w, field->data, field->ncomp);
+            MF_CALL_GOTO(rc, write_dataset(w, g, group_name, field->name, field->ncomp,
+                                           H5T_STD_I32LE, H5T_NATIVE_INT32), done);
+        }
+    }
+done:
+    H5Gclose(g);
+    return rc;
+}
+
+/* What the writer relies on; a failure here is a bug upstream, caught
+ * before anything is written. */
+static int check_particles(const mf_sim *sim, const char *path, int64_t counts[MF_NKINDS],
+                           int *max_ncomp)
+{
+    const mf_particles *p = sim->p;
+    if (!p)
+        return MF_ERROR(MF_ERR_INTERNAL, "%s: no particles to write", path);
+    if (p->dim != 2 && p->dim != 3)
+        return MF_ERROR(MF_ERR_INTERNAL, "%s: particles have dimension %d", path, p->dim);
+    if (sim->dim != 0 && sim->dim != p->dim)
+        return MF_ERROR(MF_ERR_INTERNAL, "%s: run dimension %d but particle dimension %d",
+                        path, sim->dim, p->dim);
+    for (int k = 0; k < MF_NKINDS; k++)
+        counts[k] = 0;
+    for (size_t i = 0; i < p->n_owned; i++) {
+        if (p->kind[i] >= MF_NKINDS)
+            return MF_ERROR(MF_ERR_INTERNAL, "%s: particle %zu has kind %d", path, i,
+                            p->kind[i]);
+        counts[p->kind[i]]++;
+    }
+    *max_ncomp = 3;
+    for (int f = 0; f < p->nfields; f++) {
+        const mf_field *field = &p->field[f];
+        if (!field->output)
+            continue;
+        if (mf_h5_is_core_dataset(field->name))
+            return MF_ERROR(MF_ERR_INTERNAL, "%s: field %s has the name of a core dataset",
+                            path, field->name);
+        if (field->ncomp < 1 || (field->type != MF_FIELD_DOUBLE && field->type != MF_FIELD_INT32))
+            return MF_ERROR(MF_ERR_INTERNAL, "%s: field %s has %d components of type %d", path,
+                            field->name, field->ncomp, field->type);
+        if (field->ncomp > *max_ncomp)
+            *max_ncomp = field->ncomp;
+    }
+    return 0;
+}
+
+static int write_file(snap_writer *w, const char *tmp, const mf_sim *sim,
+                      const mf_dict *params, const int64_t counts[MF_NKINDS])
+{
+    char detail[256];
+    hid_t fapl = mf_h5_fapl();
+    w->file = fapl < 0 ? H5I_INVALID_HID : H5Fcreate(tmp, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+    /* Take the message before any other HDF5 call clears the error stack. */
+    mf_h5_error_detail(detail, sizeof detail);
+    mf_h5_close(&fapl);
+    if (w->file < 0)
+        return MF_ERROR(MF_ERR_IO, "cannot create %s (%s)", tmp, detail);
+    int rc = 0;
+    MF_CALL_GOTO(rc, write_header(w, sim, counts), fail);
+    if (params)
+        MF_CALL_GOTO(rc, write_parameters(w, params), fail);
+    for (int kind = 0; kind < MF_NKINDS; kind++)
+        if (counts[kind] > 0)
+            MF_CALL_GOTO(rc, write_kind(w, kind), fail);
+    /* Closing flushes: a full disk shows up here. */
+    herr_t closed = H5Fclose(w->file);
+    w->file = H5I_INVALID_HID;
+    if (closed < 0)
+        return MF_ERROR(MF_ERR_IO, "cannot finish writing %s (%s)", tmp,
+                        mf_h5_error_detail(detail, sizeof detail));
+    return 0;
+fail:
+    mf_h5_close(&w->file);
+    return rc;
+}
+
+int mf_hdf5_write_snapshot(const char *path, const mf_sim *sim, const mf_dict *params,
+                           int compression)
+{
+    if (compression < 0 || compression > 9)
+        return MF_ERROR(MF_ERR_INPUT, "%s: compression level %d is not in 0..9", path,
+                        compression);
+    int64_t counts[MF_NKINDS];
+    int max_ncomp = 3;
+    MF_CALL(check_particles(sim, path, counts, &max_ncomp));
+    char tmp[MF_H5_PATH_MAX];
+    int len = snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    if (len < 0 || (size_t)len >= sizeof tmp)
+        return MF_ERROR(MF_ERR_INPUT, "snapshot path too long: %s", path);
+
+    const mf_particles *p = sim->p;
+    snap_writer w = {.path = path, .file = H5I_INVALID_HID, .compression = compression, .p = p};
+    size_t n = p->n_owned > 0 ? p->n_owned : 1;
+    w.index = malloc(n * sizeof *w.index);
+    w.buf = malloc(n * (size_t)max_ncomp * sizeof(double));
+    if (!w.index || !w.buf) {
+        free(w.index);
+        free(w.buf);
+        return MF_ERROR(MF_ERR_MEMORY, "%s: out of memory for %zu particles", path, n);
+    }
+
+    mf_h5_quiet quiet;
+    mf_h5_quiet_begin(&quiet);
+    int rc = write_file(&w, tmp, sim, params, counts);
+    mf_h5_quiet_end(&quiet);
+    free(w.index);
+    free(w.buf);
+    if (rc == 0)
+        rc = mf_h5_commit(tmp, path);
+    if (rc != 0) {
+        unlink(tmp); /* nothing half-written is left behind */
+        return mf_error_trace(rc, __FILE__, __LINE__, __func__);
+    }
+    return 0;
+}

@@ -1,0 +1,52 @@
+/* mf_case.h: read a case directory (OpenFOAM layout).
+ *
+ *   system/controlDict   time, writing, time-step limits, libs, functions
+ *   system/solverDict    solver NAME; <NAME>Coeffs {...}; pressure {...};
+ *                        forces { gravity { g (0 -9.81 0); } }
+ *   constant/fluids      one sub-dictionary per fluid
+ *   constant/geometry    particle spacing, fluid blocks, walls
+ */
+#ifndef MF_CASE_H
+#define MF_CASE_H
+
+#include <stdbool.h>
+
+#include "mf_dict.h"
+#include "mf_params.h"
+
+typedef struct mf_control {
+    const char *application; /* informational, as in OpenFOAM */
+    double start_time;   /* informational; a restart takes the snapshot's time */
+    double end_time;
+    double delta_t;      /* first step, or every step when !adjust_time_step */
+    bool adjust_time_step;
+    double max_co;
+    double max_di;       /* viscous number nu dt / l0^2 */
+    double max_delta_t;
+    const char *write_control; /* adjustableRunTime | timeStep */
+    double write_interval;
+    const char *writer;  /* writer module name */
+    const char *start_from; /* startTime | latestTime */
+    long max_retries;    /* retries of a failed step with a smaller dt */
+} mf_control;
+
+typedef struct mf_case {
+    char dir[4096];
+    mf_dict *control_dict, *solver_dict, *fluids, *geometry;
+    mf_control control;
+    mf_dict *resolved;   /* everything as used, defaults included */
+} mf_case;
+
+/* Read and validate the four files. On error *c is left freeable. */
+int mf_case_read(const char *dir, mf_case *c);
+void mf_case_free(mf_case *c);
+/* The words of a `libs ( ... );` entry of controlDict (NULL-terminated,
+ * pointing into the tree). */
+int mf_case_libs(const mf_case *c, const char ***libs, size_t *n);
+/* Write c->resolved to DIR/output/resolvedParameters (temp + rename). */
+int mf_case_write_resolved(const mf_case *c);
+
+extern const mf_param mf_control_params[];
+extern const size_t mf_control_nparams;
+
+#endif

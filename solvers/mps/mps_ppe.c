@@ -1,0 +1,171 @@
+/* mps_ppe.c: the pressure Poisson equation (eq. 14) and its solve.
+ *
+ * Unknowns: fluid and wall particles that are not on the free surface.
+ * Surface particles are Dirichlet p = 0 (eq. 18); dummy particles take part
+ * only in the number density. With the sign flipped, -<lap p> = rhs is
+ * symmetric positive definite:
+ *   A_ii = c sum_j w_ij (j fluid or wall),  A_ij = -c w_ij (j unknown),
+ *   c = 2d / (lambda n0),  rhs_i = relaxation (rho/dt^2) (n*_i - n0)/n0.
+ * A group of unknowns with no Dirichlet neighbour anywhere (a closed box
+ * filled to the lid) makes A singular; its diagonal is doubled there, as the
+ * Koshizuka lab's codes do, and the log says so at verbose level.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mf_error.h"
+#include "mf_run.h"
+#include "mps.h"
+
+static int reserve_system(mps_data *d, size_t rows, size_t nnz)
+{
+    if (rows + 1 > d->cap_rows) {
+        size_t cap = rows + rows / 4 + 64;
+        d->A.rowptr = realloc(d->A.rowptr, (cap + 1) * sizeof *d->A.rowptr);
+        d->rhs = realloc(d->rhs, cap * sizeof *d->rhs);
+        d->x = realloc(d->x, cap * sizeof *d->x);
+        if (!d->A.rowptr || !d->rhs || !d->x)
+            return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu pressure unknowns", rows);
+        d->cap_rows = cap;
+    }
+    if (nnz > d->cap_nnz) {
+        size_t cap = nnz + nnz / 4 + 64;
+        d->A.col = realloc(d->A.col, cap * sizeof *d->A.col);
+        d->A.val = realloc(d->A.val, cap * sizeof *d->A.val);
+        if (!d->A.col || !d->A.val)
+            return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu matrix entries", nnz);
+        d->cap_nnz = cap;
+    }
+    return 0;
+}
+
+/* Rows reachable from a row that touches a Dirichlet particle are fine;
+ * the rest form closed groups. Breadth-first over the matrix graph. */
+static size_t regularise_closed_groups(mps_data *d, const uint8_t *touches_dirichlet)
+{
+    const size_t nrows = d->A.nrows;
+    uint8_t *seen = calloc(nrows ? nrows : 1, 1);
+    size_t *queue = malloc((nrows ? nrows : 1) * sizeof *queue);
+    if (!seen || !queue) {
+        free(seen);
+        free(queue);
+        return 0;
+    }
+    size_t head = 0, tail = 0;
+    for (size_t r = 0; r < nrows; r++)
+        if (touches_dirichlet[r]) {
+            seen[r] = 1;
+            queue[tail++] = r;
+        }
+    while (head < tail) {
+        size_t r = queue[head++];
+        for (size_t k = d->A.rowptr[r]; k < d->A.rowptr[r + 1]; k++) {
+            size_t c = (size_t)(d->A.col[k] - d->A.row_offset);
+            if (c < nrows && !seen[c]) {
+                seen[c] = 1;
+                queue[tail++] = c;
+            }
+        }
+    }
+    size_t fixed = 0;
+    for (size_t r = 0; r < nrows; r++)
+        if (!seen[r]) {
+            /* The diagonal entry is stored first in each row. */
+            d->A.val[d->A.rowptr[r]] *= 2.0;
+            fixed++;
+        }
+    free(seen);
+    free(queue);
+    return fixed;
+}
+
+int mps_assemble_ppe(mps_data *d, const mf_sim *sim, double dt)
+{
+    double t0 = mf_wall_seconds();
+    const mf_particles *p = sim->p;
+    const mf_nlist *nl = d->k_lap.re >= d->nl_max.radius ? &d->nl_max : &d->nl_lap;
+    const double *n = mf_particles_fd(p, d->f_number_density);
+    size_t nrows = 0, nnz = 0;
+    for (size_t i = 0; i < p->n_owned; i++) {
+        d->row[i] = d->in_ppe[i] ? (long)nrows++ : -1;
+        if (d->in_ppe[i]) {
+            nnz++;
+            for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++)
+                nnz += d->in_ppe[nl->j[k]];
+        }
+    }
+    MF_CALL(reserve_system(d, nrows, nnz));
+    uint8_t *touches = calloc(nrows ? nrows : 1, 1);
+    if (!touches)
+        return MF_ERROR(MF_ERR_MEMORY, "out of memory");
+    mf_csr *A = &d->A;
+    A->nrows = nrows;
+    A->row_offset = p->global_offset;
+    A->nglobal = (int64_t)nrows; /* one rank */
+    const double c = 2.0 * d->k_lap.dim / (d->k_lap.lambda * d->k_lap.n0);
+    const double rho = sim->fluid[0].rho, n0 = d->k_nd.n0, re = nl->radius;
+    const double *pressure = mf_particles_fd(p, d->f_pressure);
+    size_t pos = 0;
+    for (size_t i = 0; i < p->n_owned; i++) {
+        if (!d->in_ppe[i])
+            continue;
+        size_t r = (size_t)d->row[i];
+        A->rowptr[r] = pos;
+        size_t diag = pos++;
+        A->col[diag] = A->row_offset + (int64_t)r;
+        double sum = 0;
+        for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
+            size_t j = nl->j[k];
+            if (!d->not_dummy[j])
+                continue;
+            double dx = p->pos[3 * j] - p->pos[3 * i], dy = p->pos[3 * j + 1] - p->pos[3 * i + 1],
+                   dz = p->pos[3 * j + 2] - p->pos[3 * i + 2];
+            double w = mf_weight(sqrt(dx * dx + dy * dy + dz * dz), re);
+            sum += c * w;
+            if (d->in_ppe[j]) {
+                A->col[pos] = A->row_offset + d->row[j];
+                A->val[pos++] = -c * w;
+            } else if (w > 0) {
+                touches[r] = 1; /* a Dirichlet neighbour */
+            }
+        }
+        A->val[diag] = sum + d->s.compressibility * rho / (dt * dt);
+        if (d->s.compressibility > 0)
+            touches[r] = 1;
+        d->rhs[r] = d->s.relaxation * rho / (dt * dt) * (n[i] - n0) / n0;
+        d->x[r] = pressure[i]; /* warm start from the last step */
+    }
+    A->rowptr[nrows] = pos;
+    size_t closed = regularise_closed_groups(d, touches);
+    free(touches);
+    if (closed)
+        mf_log_printf(sim->log, MF_LOG_VERBOSE,
+                      "PPE: %zu unknowns have no free surface to refer to: diagonal doubled\n",
+                      closed);
+    d->ppe_rows = (long)nrows;
+    d->t_assembly += mf_wall_seconds() - t0;
+    return 0;
+}
+
+int mps_solve_ppe(mps_data *d, mf_sim *sim)
+{
+    double t0 = mf_wall_seconds();
+    mf_particles *p = sim->p;
+    int rc = d->pressure_ops->solve(d->pressure.data, &d->A, d->rhs, d->x, &d->last);
+    mf_log_printf(sim->log, MF_LOG_STEP,
+                  "%s:  Solving for p, Initial residual = %g, Final residual = %g, No "
+                  "Iterations %d\n",
+                  d->pressure.info->name, d->last.initial_residual, d->last.final_residual,
+                  d->last.iterations);
+    sim->pressure_iterations += d->last.iterations;
+    d->t_solve += mf_wall_seconds() - t0;
+    if (rc != 0)
+        return mf_error_trace(rc, __FILE__, __LINE__, __func__);
+    double *pressure = mf_particles_fd(p, d->f_pressure);
+    for (size_t i = 0; i < p->n_owned; i++) {
+        double v = d->row[i] >= 0 ? d->x[d->row[i]] : 0.0;
+        pressure[i] = (d->s.clip_negative_pressure && v < 0) ? 0.0 : v;
+    }
+    return 0;
+}

@@ -1,0 +1,194 @@
+/* mps_step.c: one MPS step, phase by phase (the paper's Algorithm 1). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mf_error.h"
+#include "mf_operators.h"
+#include "mf_run.h"
+#include "mps.h"
+
+static double max_radius(const mps_data *d)
+{
+    double r = d->k_nd.re;
+    if (d->k_grad.re > r) r = d->k_grad.re;
+    if (d->k_lap.re > r) r = d->k_lap.re;
+    return r;
+}
+
+/* The list for an operator: the full list when its radius is the largest. */
+static const mf_nlist *list_for(const mps_data *d, const mf_nlist *filtered, double re)
+{
+    return re >= d->nl_max.radius ? &d->nl_max : filtered;
+}
+
+static int filter_lists(mps_data *d, const mf_particles *p)
+{
+    if (d->k_nd.re < d->nl_max.radius)
+        MF_CALL(mf_nlist_filter(&d->nl_nd, &d->nl_max, p, d->k_nd.re));
+    if (d->k_grad.re < d->nl_max.radius)
+        MF_CALL(mf_nlist_filter(&d->nl_grad, &d->nl_max, p, d->k_grad.re));
+    if (d->k_lap.re < d->nl_max.radius)
+        MF_CALL(mf_nlist_filter(&d->nl_lap, &d->nl_max, p, d->k_lap.re));
+    return 0;
+}
+
+int mps_build_neighbours(mps_data *d, mf_sim *sim, bool reorder)
+{
+    double t0 = mf_wall_seconds();
+    mf_particles *p = sim->p;
+    const double rmax = max_radius(d);
+    MF_CALL(mf_grid_build(&d->grid, p, rmax));
+    if (reorder && d->s.reorder_interval > 0 && sim->step % d->s.reorder_interval == 0) {
+        /* Sort along cells: neighbours become neighbours in memory too. */
+        size_t *perm = malloc(p->n * sizeof *perm);
+        if (!perm)
+            return MF_ERROR(MF_ERR_MEMORY, "out of memory reordering particles");
+        int rc = mf_grid_locality_order(&d->grid, perm);
+        if (rc == 0)
+            rc = mf_particles_permute(p, perm);
+        free(perm);
+        MF_CALL(rc);
+        MF_CALL(mf_grid_build(&d->grid, p, rmax));
+    }
+    MF_CALL(mf_nlist_build(&d->nl_max, &d->grid, p, rmax));
+    MF_CALL(filter_lists(d, p));
+    d->t_neighbours += mf_wall_seconds() - t0;
+    return 0;
+}
+
+static void set_masks(mps_data *d, const mf_particles *p)
+{
+    for (size_t i = 0; i < p->n; i++) {
+        d->is_fluid[i] = p->kind[i] == MF_FLUID;
+        d->not_dummy[i] = p->kind[i] != MF_DUMMY;
+    }
+}
+
+/* Optional collision model (Koshizuka lab's MPS codes): approaching pairs
+ * closer than the collision distance exchange momentum with restitution e. */
+static void collide(mps_data *d, mf_sim *sim, double dt)
+{
+    mf_particles *p = sim->p;
+    const mf_nlist *nl = list_for(d, &d->nl_grad, d->k_grad.re);
+    const double dc = d->s.collision_distance * sim->l0, e = d->s.restitution;
+    for (size_t i = 0; i < p->n_owned; i++) {
+        if (!d->is_fluid[i])
+            continue;
+        double *vi = &d->grad[3 * i]; /* scratch: new velocity of i */
+        memcpy(vi, &p->vel[3 * i], 3 * sizeof(double));
+        for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
+            size_t j = nl->j[k];
+            double r[3], r2 = 0;
+            for (int c = 0; c < 3; c++) {
+                r[c] = p->pos[3 * j + c] - p->pos[3 * i + c];
+                r2 += r[c] * r[c];
+            }
+            if (r2 >= dc * dc || r2 <= 0)
+                continue;
+            double len = sqrt(r2), approach = 0;
+            for (int c = 0; c < 3; c++)
+                approach += (vi[c] - p->vel[3 * j + c]) * r[c] / len;
+            if (approach <= 0)
+                continue;
+            /* Equal masses; a wall (fixed) counts as infinitely heavy. */
+            double share = d->is_fluid[j] ? 0.5 : 1.0;
+            for (int c = 0; c < 3; c++)
+                vi[c] -= share * (1 + e) * approach * r[c] / len;
+        }
+    }
+    for (size_t i = 0; i < p->n_owned; i++)
+        if (d->is_fluid[i])
+            for (int c = 0; c < 3; c++) {
+                p->pos[3 * i + c] += dt * (d->grad[3 * i + c] - p->vel[3 * i + c]);
+                p->vel[3 * i + c] = d->grad[3 * i + c];
+            }
+}
+
+/* eqs. 9-10: u* = u + dt (nu lap u + forces), r* = r + dt u*. */
+int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
+{
+    double t0 = mf_wall_seconds();
+    mf_particles *p = sim->p;
+    const double nu = sim->fluid[0].nu;
+    memset(d->acc, 0, 3 * p->n * sizeof *d->acc);
+    for (size_t k = 0; k < sim->nforces; k++) {
+        const mf_force_ops *ops = (const mf_force_ops *)sim->forces[k].info;
+        MF_CALL(ops->accumulate(sim->forces[k].data, sim, d->acc));
+    }
+    if (nu > 0) {
+        const mf_nlist *nl = list_for(d, &d->nl_lap, d->k_lap.re);
+        mf_laplacian(p, nl, &d->k_lap, p->vel, 3, d->is_fluid, NULL, d->grad);
+        for (size_t i = 0; i < p->n_owned; i++)
+            if (d->is_fluid[i])
+                for (int c = 0; c < 3; c++)
+                    d->acc[3 * i + c] += nu * d->grad[3 * i + c];
+    }
+    for (size_t i = 0; i < p->n_owned; i++) {
+        if (!d->is_fluid[i])
+            continue;
+        for (int c = 0; c < 3; c++) {
+            p->vel[3 * i + c] += dt * d->acc[3 * i + c];
+            p->pos[3 * i + c] += dt * p->vel[3 * i + c];
+        }
+    }
+    if (d->s.collision)
+        collide(d, sim, dt);
+    d->t_explicit += mf_wall_seconds() - t0;
+    return 0;
+}
+
+/* eqs. 11-14 and 18: number density at r*, free surface, PPE. */
+int mps_pressure_phase(mps_data *d, mf_sim *sim, double dt)
+{
+    mf_particles *p = sim->p;
+    double *n = mf_particles_fd(p, d->f_number_density);
+    int32_t *flags = mf_particles_fi(p, d->f_flags);
+    mf_number_density(p, list_for(d, &d->nl_nd, d->k_nd.re), d->not_dummy, NULL, n);
+    const double n0 = d->k_nd.n0;
+    for (size_t i = 0; i < p->n_owned; i++) {
+        bool surface = d->not_dummy[i] && n[i] < d->s.beta * n0;
+        d->dirichlet[i] = surface;
+        d->in_ppe[i] = d->not_dummy[i] && !surface;
+        flags[i] = surface ? MPS_FLAG_SURFACE : 0;
+        if (!d->not_dummy[i])
+            n[i] = 0; /* dummies take part only as neighbours */
+    }
+    MF_CALL(mps_assemble_ppe(d, sim, dt));
+    MF_CALL(mps_solve_ppe(d, sim));
+    return 0;
+}
+
+/* eqs. 15-17: u' = -(dt/rho) <grad p>, u = u* + u', r = r* + dt u'. */
+int mps_correction_phase(mps_data *d, mf_sim *sim, double dt)
+{
+    double t0 = mf_wall_seconds();
+    mf_particles *p = sim->p;
+    const double *pr = mf_particles_fd(p, d->f_pressure);
+    mf_gradient(p, list_for(d, &d->nl_grad, d->k_grad.re), &d->k_grad, pr, d->s.gradient_pmin,
+                d->is_fluid, d->not_dummy, d->grad);
+    const double rho = sim->fluid[0].rho;
+    for (size_t i = 0; i < p->n_owned; i++) {
+        if (!d->is_fluid[i])
+            continue;
+        for (int c = 0; c < 3; c++) {
+            double du = -dt / rho * d->grad[3 * i + c];
+            p->vel[3 * i + c] += du;
+            p->pos[3 * i + c] += dt * du;
+        }
+    }
+    d->t_correction += mf_wall_seconds() - t0;
+    return 0;
+}
+
+int mps_lagrangian_step(mps_data *d, mf_sim *sim, double dt)
+{
+    MF_CALL(mps_reserve(d, sim->p->n));
+    MF_CALL(mps_build_neighbours(d, sim, true)); /* at r^n, for viscosity */
+    set_masks(d, sim->p);
+    MF_CALL(mps_explicit_phase(d, sim, dt));
+    MF_CALL(mps_build_neighbours(d, sim, false)); /* at r*, for the pressure */
+    MF_CALL(mps_pressure_phase(d, sim, dt));
+    MF_CALL(mps_correction_phase(d, sim, dt));
+    return 0;
+}

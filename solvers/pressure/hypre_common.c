@@ -1,0 +1,485 @@
+/* hypre_common.c: what PCG_BoomerAMG and PCG_diagonal share: checks of the
+ * system, residual norms from the caller's CSR, assembly of the hypre IJ
+ * objects, the PCG run and the report. The modules only choose the
+ * preconditioner (see mf_hypre_pcg in pressure_hypre.h).
+ *
+ * Collective calls (MPI_Allreduce, hypre assembly, the solve) are made by
+ * every rank in the same order; a failure found on one rank alone is first
+ * agreed on (mf_hypre_agree) so that the others do not wait for it.
+ */
+#define MF_PRESSURE_HYPRE_INTERNAL
+#include "pressure_hypre.h"
+
+#include <inttypes.h>
+#include <limits.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <mpi.h>
+
+#include "mf_error.h"
+
+/* Largest values hypre's index types hold in this build (Debian's 2.26:
+ * both 32-bit). */
+#define HYPRE_BIGINT_MAX (sizeof(HYPRE_BigInt) == 8 ? (int64_t)INT64_MAX : (int64_t)INT32_MAX)
+#define HYPRE_INT_MAX (sizeof(HYPRE_Int) == 8 ? (int64_t)INT64_MAX : (int64_t)INT32_MAX)
+
+/* ---- errors and agreement ---------------------------------------------- */
+
+int mf_hypre_error(const char *who, const char *hypre_func, HYPRE_Int code, const char *file,
+                   int line, const char *func)
+{
+    char descr[512] = "";
+    HYPRE_DescribeError(code, descr);
+    HYPRE_ClearAllErrors();
+    return mf_error_raise(MF_ERR_LIBRARY, file, line, func, "%s: %s failed (hypre error %d: %s)",
+                          who, hypre_func, (int)code, descr);
+}
+
+int mf_hypre_agree(const char *who, int rc)
+{
+    int mine = rc != 0, any = 0;
+    MPI_Allreduce(&mine, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+    if (rc != 0)
+        return rc;
+    if (any)
+        return MF_ERROR(MF_ERR_INPUT, "%s: another MPI rank failed (see its message)", who);
+    return 0;
+}
+
+int mf_hypre_check_pcg_settings(const char *who, double tolerance, long max_iter)
+{
+    if (!(tolerance > 0.0 && tolerance <= 1.0))
+        return MF_ERROR(MF_ERR_INPUT, "%s: tolerance %g is not in (0, 1]", who, tolerance);
+    if (max_iter < 1 || max_iter > HYPRE_INT_MAX)
+        return MF_ERROR(MF_ERR_INPUT, "%s: maxIter %ld is not in [1, %" PRId64 "]", who, max_iter,
+                        HYPRE_INT_MAX);
+    return 0;
+}
+
+/* ---- the row layout over the ranks --------------------------------------- */
+
+typedef struct layout {
+    int nprocs;
+    int *counts; /* rows of each rank (only when nprocs > 1) */
+    int *displs; /* first global row of each rank */
+} layout;
+
+static void layout_free(layout *lay)
+{
+    free(lay->counts);
+    free(lay->displs);
+    lay->counts = lay->displs = NULL;
+}
+
+/* Local checks of this rank's part: sizes that fit hypre's index types, a
+ * monotone rowptr, columns inside the matrix. */
+static int check_local(const char *who, const mf_csr *A, const double *b, const double *x)
+{
+    if (A == NULL)
+        return MF_ERROR(MF_ERR_INPUT, "%s: no matrix", who);
+    if (A->nglobal < 0 || A->row_offset < 0 || (uint64_t)A->nrows > (uint64_t)INT64_MAX ||
+        A->row_offset > A->nglobal - (int64_t)A->nrows)
+        return MF_ERROR(MF_ERR_INPUT,
+                        "%s: local rows [%" PRId64 ", %" PRId64 ") are not inside the %" PRId64
+                        " rows of the matrix",
+                        who, A->row_offset, A->row_offset + (int64_t)A->nrows, A->nglobal);
+    if (A->nglobal > HYPRE_BIGINT_MAX)
+        return MF_ERROR(MF_ERR_INPUT,
+                        "%s: the matrix has %" PRId64 " rows but this hypre build's HYPRE_BigInt "
+                        "holds at most %" PRId64 " (rebuild hypre with --enable-bigint)",
+                        who, A->nglobal, HYPRE_BIGINT_MAX);
+    if ((int64_t)A->nrows > HYPRE_INT_MAX)
+        return MF_ERROR(MF_ERR_INPUT, "%s: %zu local rows exceed hypre's HYPRE_Int", who,
+                        A->nrows);
+    if (A->nrows == 0)
+        return 0;
+    if (A->rowptr == NULL || b == NULL || x == NULL)
+        return MF_ERROR(MF_ERR_INPUT, "%s: NULL rowptr, right-hand side or solution", who);
+    for (size_t i = 0; i < A->nrows; i++)
+        if (A->rowptr[i + 1] < A->rowptr[i])
+            return MF_ERROR(MF_ERR_INPUT, "%s: rowptr decreases at local row %zu", who, i);
+    size_t nnz = A->rowptr[A->nrows] - A->rowptr[0];
+    if ((uint64_t)nnz > (uint64_t)HYPRE_INT_MAX)
+        return MF_ERROR(MF_ERR_INPUT,
+                        "%s: %zu local non-zeros exceed hypre's HYPRE_Int (use more ranks)", who,
+                        nnz);
+    if (nnz > 0 && (A->col == NULL || A->val == NULL))
+        return MF_ERROR(MF_ERR_INPUT, "%s: NULL column or value array", who);
+    for (size_t k = A->rowptr[0]; k < A->rowptr[A->nrows]; k++)
+        if (A->col[k] < 0 || A->col[k] >= A->nglobal) {
+            size_t i = 0;
+            while (A->rowptr[i + 1] <= k)
+                i++;
+            return MF_ERROR(MF_ERR_INPUT,
+                            "%s: column %" PRId64 " in row %" PRId64 " is outside [0, %" PRId64
+                            ") (it must also fit HYPRE_BigInt)",
+                            who, A->col[k], A->row_offset + (int64_t)i, A->nglobal);
+        }
+    return 0;
+}
+
+/* Collective: check every rank's part, then that the ranks' row ranges
+ * follow each other in rank order and cover [0, nglobal) (hypre's IJ layout). */
+static int check_system(const char *who, const mf_csr *A, const double *b, const double *x,
+                        layout *lay)
+{
+    memset(lay, 0, sizeof *lay);
+    MF_CALL(mf_hypre_agree(who, check_local(who, A, b, x)));
+    MPI_Comm_size(MPI_COMM_WORLD, &lay->nprocs);
+    if (lay->nprocs == 1) {
+        if (A->row_offset != 0 || (int64_t)A->nrows != A->nglobal)
+            return MF_ERROR(MF_ERR_INPUT,
+                            "%s: a single rank must own all %" PRId64 " rows (it owns [%" PRId64
+                            ", %" PRId64 "))",
+                            who, A->nglobal, A->row_offset, A->row_offset + (int64_t)A->nrows);
+        return 0;
+    }
+    /* Several ranks: the residual gathers x, so offsets must fit an int too. */
+    int rc = 0;
+    int64_t mine[3] = {A->row_offset, (int64_t)A->nrows, A->nglobal};
+    int64_t *all = malloc(3 * (size_t)lay->nprocs * sizeof *all);
+    lay->counts = malloc((size_t)lay->nprocs * sizeof *lay->counts);
+    lay->displs = malloc((size_t)lay->nprocs * sizeof *lay->displs);
+    if (all == NULL || lay->counts == NULL || lay->displs == NULL)
+        rc = MF_ERROR(MF_ERR_MEMORY, "%s: out of memory for the row layout", who);
+    MF_CALL_GOTO(rc, mf_hypre_agree(who, rc), fail);
+    MPI_Allgather(mine, 3, MPI_INT64_T, all, 3, MPI_INT64_T, MPI_COMM_WORLD);
+    int64_t next = 0;
+    for (int p = 0; p < lay->nprocs; p++) {
+        const int64_t *r = all + 3 * p;
+        if (r[0] != next || r[2] != A->nglobal || A->nglobal > INT_MAX) {
+            rc = MF_ERROR(MF_ERR_INPUT,
+                          "%s: rank %d owns rows [%" PRId64 ", %" PRId64 ") of %" PRId64
+                          "; ranks must own consecutive ranges in rank order starting at 0 "
+                          "(and at most %d rows in all)",
+                          who, p, r[0], r[0] + r[1], r[2], INT_MAX);
+            goto fail;
+        }
+        lay->displs[p] = (int)r[0];
+        lay->counts[p] = (int)r[1];
+        next = r[0] + r[1];
+    }
+    if (next != A->nglobal) {
+        rc = MF_ERROR(MF_ERR_INPUT, "%s: the ranks own %" PRId64 " of the %" PRId64 " rows", who,
+                      next, A->nglobal);
+        goto fail;
+    }
+    free(all);
+    return 0;
+fail:
+    free(all);
+    layout_free(lay);
+    return rc;
+}
+
+/* ---- norms from the caller's CSR ----------------------------------------- */
+
+static double global_sum(double local)
+{
+    double sum = 0.0;
+    MPI_Allreduce(&local, &sum, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+    return sum;
+}
+
+/* ||b - A x|| over all ranks, from the caller's CSR (independent of the hypre
+ * copy, so a wrong assembly would show here). On several ranks the columns
+ * of other ranks need their x: gather the whole vector (O(nglobal) memory
+ * per rank; good enough until the solver runs on many ranks). */
+static int residual_norm(const char *who, const mf_csr *A, const double *b, const double *x,
+                         const layout *lay, double *norm)
+{
+    const double *xg = x;
+    int64_t shift = A->row_offset; /* global column -> index into xg */
+    double *gathered = NULL;
+    int rc = 0;
+    if (lay->nprocs > 1) {
+        gathered = malloc(((size_t)A->nglobal + 1) * sizeof *gathered);
+        if (gathered == NULL)
+            rc = MF_ERROR(MF_ERR_MEMORY, "%s: out of memory gathering x (%" PRId64 " rows)", who,
+                          A->nglobal);
+        rc = mf_hypre_agree(who, rc);
+        if (rc != 0) {
+            free(gathered);
+            return mf_error_trace(rc, __FILE__, __LINE__, __func__);
+        }
+        MPI_Allgatherv(x, (int)A->nrows, MPI_DOUBLE, gathered, lay->counts, lay->displs,
+                       MPI_DOUBLE, MPI_COMM_WORLD);
+        xg = gathered;
+        shift = 0;
+    }
+    double sum = 0.0;
+    for (size_t i = 0; i < A->nrows; i++) {
+        double r = b[i];
+        for (size_t k = A->rowptr[i]; k < A->rowptr[i + 1]; k++)
+            r -= A->val[k] * xg[A->col[k] - shift];
+        sum += r * r;
+    }
+    free(gathered);
+    *norm = sqrt(global_sum(sum));
+    return 0;
+}
+
+/* ---- assembly ------------------------------------------------------------ */
+
+typedef struct hypre_system {
+    HYPRE_IJMatrix A;
+    HYPRE_IJVector b, x;
+    HYPRE_ParCSRMatrix parA;
+    HYPRE_ParVector parb, parx;
+    HYPRE_BigInt *rows; /* global index of each local row */
+} hypre_system;
+
+static void system_free(hypre_system *sys)
+{
+    if (sys->A)
+        HYPRE_IJMatrixDestroy(sys->A);
+    if (sys->b)
+        HYPRE_IJVectorDestroy(sys->b);
+    if (sys->x)
+        HYPRE_IJVectorDestroy(sys->x);
+    free(sys->rows);
+    memset(sys, 0, sizeof *sys);
+}
+
+static int assemble_vector(const char *who, HYPRE_BigInt ilower, HYPRE_BigInt iupper,
+                           HYPRE_Int n, const HYPRE_BigInt *rows, const double *values,
+                           HYPRE_IJVector *ij, HYPRE_ParVector *par)
+{
+    int rc = 0;
+    void *obj = NULL;
+    MF_HYPRE_CALL(who, rc, out, HYPRE_IJVectorCreate, (MPI_COMM_WORLD, ilower, iupper, ij));
+    MF_HYPRE_CALL(who, rc, out, HYPRE_IJVectorSetObjectType, (*ij, HYPRE_PARCSR));
+    MF_HYPRE_CALL(who, rc, out, HYPRE_IJVectorSetPrintLevel, (*ij, 0));
+    MF_HYPRE_CALL(who, rc, out, HYPRE_IJVectorInitialize, (*ij));
+    MF_HYPRE_CALL(who, rc, out, HYPRE_IJVectorSetValues, (*ij, n, rows, values));
+    MF_HYPRE_CALL(who, rc, out, HYPRE_IJVectorAssemble, (*ij));
+    MF_HYPRE_CALL(who, rc, out, HYPRE_IJVectorGetObject, (*ij, &obj));
+    *par = (HYPRE_ParVector)obj;
+out:
+    return rc;
+}
+
+/* Copy the CSR, b and x into hypre IJ objects. The matrix goes in with ONE
+ * HYPRE_IJMatrixSetValues call for all local rows, after telling hypre the
+ * exact diagonal-block / off-diagonal-block counts of every row, so it
+ * allocates once and never needs its auxiliary (row-by-row) structure. */
+static int assemble(const char *who, const mf_csr *A, const double *b, const double *x,
+                    hypre_system *sys)
+{
+    const HYPRE_Int n = (HYPRE_Int)A->nrows;
+    const HYPRE_BigInt ilower = (HYPRE_BigInt)A->row_offset;
+    const HYPRE_BigInt iupper = ilower + n - 1; /* ilower - 1 on a rank with no rows */
+    const size_t k0 = n > 0 ? A->rowptr[0] : 0;
+    const size_t nnz = n > 0 ? A->rowptr[n] - k0 : 0;
+    int rc = 0;
+    void *obj = NULL;
+
+    memset(sys, 0, sizeof *sys);
+    /* +1: malloc(0) may return NULL, which would read as a failure. */
+    HYPRE_Int *ncols = malloc(((size_t)n + 1) * sizeof *ncols);
+    HYPRE_Int *diag_sizes = malloc(((size_t)n + 1) * sizeof *diag_sizes);
+    HYPRE_Int *offd_sizes = malloc(((size_t)n + 1) * sizeof *offd_sizes);
+    HYPRE_BigInt *cols = malloc((nnz + 1) * sizeof *cols);
+    sys->rows = malloc(((size_t)n + 1) * sizeof *sys->rows);
+    if (ncols == NULL || diag_sizes == NULL || offd_sizes == NULL || cols == NULL ||
+        sys->rows == NULL)
+        rc = MF_ERROR(MF_ERR_MEMORY, "%s: out of memory copying %zu non-zeros for hypre", who,
+                      nnz);
+    MF_CALL_GOTO(rc, mf_hypre_agree(who, rc), out);
+
+    /* Global columns were checked against nglobal, which fits HYPRE_BigInt. */
+    for (HYPRE_Int i = 0; i < n; i++) {
+        HYPRE_Int ndiag = 0, noffd = 0;
+        sys->rows[i] = ilower + i;
+        for (size_t k = A->rowptr[i]; k < A->rowptr[i + 1]; k++) {
+            HYPRE_BigInt c = (HYPRE_BigInt)A->col[k];
+            cols[k - k0] = c;
+            if (c >= ilower && c <= iupper)
+                ndiag++;
+            else
+                noffd++;
+        }
+        ncols[i] = ndiag + noffd;
+        diag_sizes[i] = ndiag;
+        offd_sizes[i] = noffd;
+    }
+
+    MF_HYPRE_CALL(who, rc, out, HYPRE_IJMatrixCreate,
+                  (MPI_COMM_WORLD, ilower, iupper, ilower, iupper, &sys->A));
+    MF_HYPRE_CALL(who, rc, out, HYPRE_IJMatrixSetObjectType, (sys->A, HYPRE_PARCSR));
+    MF_HYPRE_CALL(who, rc, out, HYPRE_IJMatrixSetPrintLevel, (sys->A, 0));
+    MF_HYPRE_CALL(who, rc, out, HYPRE_IJMatrixSetDiagOffdSizes, (sys->A, diag_sizes, offd_sizes));
+    MF_HYPRE_CALL(who, rc, out, HYPRE_IJMatrixInitialize, (sys->A));
+    MF_HYPRE_CALL(who, rc, out, HYPRE_IJMatrixSetValues,
+                  (sys->A, n, ncols, sys->rows, cols, n > 0 ? A->val + k0 : NULL));
+    MF_HYPRE_CALL(who, rc, out, HYPRE_IJMatrixAssemble, (sys->A));
+    MF_HYPRE_CALL(who, rc, out, HYPRE_IJMatrixGetObject, (sys->A, &obj));
+    sys->parA = (HYPRE_ParCSRMatrix)obj;
+
+    MF_CALL_GOTO(rc, assemble_vector(who, ilower, iupper, n, sys->rows, b, &sys->b, &sys->parb),
+                 out);
+    MF_CALL_GOTO(rc, assemble_vector(who, ilower, iupper, n, sys->rows, x, &sys->x, &sys->parx),
+                 out);
+out:
+    free(ncols);
+    free(diag_sizes);
+    free(offd_sizes);
+    free(cols);
+    if (rc != 0)
+        system_free(sys);
+    return rc;
+}
+
+/* ---- pattern fingerprint (for reusing an AMG hierarchy) ------------------ */
+
+/* One 64-bit word into the running hash: splitmix64's finaliser on the
+ * word, then an FNV-style combine (word by word: the pattern of a million
+ * rows is 30 million words). */
+static uint64_t hash_word(uint64_t h, uint64_t v)
+{
+    v += 0x9e3779b97f4a7c15ull;
+    v = (v ^ (v >> 30)) * 0xbf58476d1ce4e5b9ull;
+    v = (v ^ (v >> 27)) * 0x94d049bb133111ebull;
+    v ^= v >> 31;
+    return (h ^ v) * 0x100000001b3ull;
+}
+
+int mf_hypre_pattern_hash(const mf_csr *A, uint64_t *hash)
+{
+    int rank = 0;
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    uint64_t h = 0xcbf29ce484222325ull;
+    h = hash_word(h, (uint64_t)rank);
+    h = hash_word(h, (uint64_t)A->nglobal);
+    h = hash_word(h, (uint64_t)A->row_offset);
+    h = hash_word(h, (uint64_t)A->nrows);
+    for (size_t i = 0; i < A->nrows; i++) {
+        h = hash_word(h, (uint64_t)(A->rowptr[i + 1] - A->rowptr[i]));
+        for (size_t k = A->rowptr[i]; k < A->rowptr[i + 1]; k++)
+            h = hash_word(h, (uint64_t)A->col[k]);
+    }
+    /* One value on every rank, so all ranks take the same reuse decision. */
+    MPI_Allreduce(&h, hash, 1, MPI_UINT64_T, MPI_BXOR, MPI_COMM_WORLD);
+    return 0;
+}
+
+/* ---- the solve ----------------------------------------------------------- */
+
+int mf_hypre_pcg_solve(const mf_hypre_pcg *pcg, const mf_csr *A, const double *b, double *x,
+                       mf_solve_report *rep)
+{
+    const char *who = pcg->name;
+    const double t_start = MPI_Wtime();
+    mf_solve_report unused;
+    layout lay;
+    hypre_system sys = {0};
+    mf_hypre_precond pc = {0};
+    HYPRE_Solver solver = NULL;
+    bool prepared = false, converged = false;
+    int rc = 0;
+
+    if (rep == NULL)
+        rep = &unused;
+    memset(rep, 0, sizeof *rep);
+    MF_CALL(mf_hypre_check_pcg_settings(who, pcg->tolerance, pcg->max_iter));
+    MF_CALL(check_system(who, A, b, x, &lay));
+
+    /* Cheap exits first: they need neither assembly nor a preconditioner. */
+    double bnorm = 0.0;
+    for (size_t i = 0; i < A->nrows; i++)
+        bnorm += b[i] * b[i];
+    bnorm = sqrt(global_sum(bnorm));
+    if (!isfinite(bnorm)) {
+        rc = MF_ERROR(MF_ERR_NUMERIC, "%s: the right-hand side holds NaN or Inf", who);
+        goto done;
+    }
+    if (bnorm == 0.0) {
+        /* A x = 0 with A SPD: x = 0 exactly, whatever the guess. */
+        for (size_t i = 0; i < A->nrows; i++)
+            x[i] = 0.0;
+        converged = true;
+        rep->converged = true;
+        rep->setup_seconds = MPI_Wtime() - t_start;
+        goto done;
+    }
+    double rnorm = 0.0;
+    MF_CALL_GOTO(rc, residual_norm(who, A, b, x, &lay, &rnorm), done);
+    rep->initial_residual = rnorm / bnorm;
+    if (!isfinite(rep->initial_residual)) {
+        rc = MF_ERROR(MF_ERR_NUMERIC,
+                      "%s: the initial residual is not finite: the matrix or the initial guess "
+                      "holds NaN or Inf",
+                      who);
+        goto done;
+    }
+    if (rep->initial_residual <= pcg->tolerance) {
+        /* A warm start that already satisfies the tolerance: nothing to do. */
+        rep->final_residual = rep->initial_residual;
+        converged = true;
+        rep->converged = true;
+        rep->setup_seconds = MPI_Wtime() - t_start;
+        goto done;
+    }
+
+    /* hypre's error flag is global and sticky: start clean so that a failure
+     * left by someone else is not reported as ours. */
+    HYPRE_ClearAllErrors();
+    MF_CALL_GOTO(rc, assemble(who, A, b, x, &sys), done);
+    rc = pcg->precond_prepare(pcg->ctx, A, &pc);
+    prepared = rc == 0;
+    MF_CALL_GOTO(rc, mf_hypre_agree(who, rc), done);
+
+    MF_HYPRE_CALL(who, rc, done, HYPRE_ParCSRPCGCreate, (MPI_COMM_WORLD, &solver));
+    MF_HYPRE_CALL(who, rc, done, HYPRE_PCGSetTol, (solver, pcg->tolerance));
+    MF_HYPRE_CALL(who, rc, done, HYPRE_PCGSetMaxIter, (solver, (HYPRE_Int)pcg->max_iter));
+    /* Stop on ||r||_2 / ||b||_2, the residual we report, not the
+     * preconditioned norm. */
+    MF_HYPRE_CALL(who, rc, done, HYPRE_PCGSetTwoNorm, (solver, 1));
+    /* Before accepting convergence, recompute r = b - A x (one matvec): the
+     * recursively updated residual drifts from the true one, and we judge
+     * convergence by the true one below. */
+    MF_HYPRE_CALL(who, rc, done, HYPRE_PCGSetRecomputeResidual, (solver, 1));
+    MF_HYPRE_CALL(who, rc, done, HYPRE_PCGSetPrintLevel, (solver, 0));
+    MF_HYPRE_CALL(who, rc, done, HYPRE_PCGSetLogging, (solver, 0));
+    MF_HYPRE_CALL(who, rc, done, HYPRE_ParCSRPCGSetPrecond, (solver, pc.solve, pc.setup, pc.solver));
+    MF_HYPRE_CALL(who, rc, done, HYPRE_ParCSRPCGSetup, (solver, sys.parA, sys.parb, sys.parx));
+    const double t_solve = MPI_Wtime();
+    rep->setup_seconds = t_solve - t_start;
+
+    /* x holds the caller's initial guess: PCG starts from it. HYPRE_ERROR_CONV
+     * (iteration limit, or a breakdown) is not a library failure: the true
+     * residual below decides, and the caller may retry. */
+    HYPRE_Int ierr = HYPRE_ParCSRPCGSolve(solver, sys.parA, sys.parb, sys.parx);
+    if (ierr & ~HYPRE_ERROR_CONV) {
+        rc = mf_hypre_error(who, "HYPRE_ParCSRPCGSolve", ierr, __FILE__, __LINE__, __func__);
+        goto done;
+    }
+    HYPRE_ClearAllErrors();
+    HYPRE_Int iterations = 0;
+    MF_HYPRE_CALL(who, rc, done, HYPRE_ParCSRPCGGetNumIterations, (solver, &iterations));
+    rep->iterations = (int)iterations;
+    MF_HYPRE_CALL(who, rc, done, HYPRE_IJVectorGetValues,
+                  (sys.x, (HYPRE_Int)A->nrows, sys.rows, x));
+
+    /* The honest number: ||b - A x|| / ||b|| from the caller's matrix. */
+    MF_CALL_GOTO(rc, residual_norm(who, A, b, x, &lay, &rnorm), done);
+    rep->final_residual = rnorm / bnorm;
+    converged = rep->final_residual <= pcg->tolerance; /* false for NaN */
+    rep->converged = converged;
+    rep->solve_seconds = MPI_Wtime() - t_solve;
+
+done:
+    if (solver)
+        HYPRE_ParCSRPCGDestroy(solver);
+    if (prepared && pcg->precond_release)
+        pcg->precond_release(pcg->ctx, rc == 0 && converged);
+    system_free(&sys);
+    layout_free(&lay);
+    if (rc == 0 && !converged)
+        rc = MF_ERROR(MF_RETRY,
+                      "%s: not converged after %d iterations (final residual %g > tolerance %g)",
+                      who, rep->iterations, rep->final_residual, pcg->tolerance);
+    return rc;
+}

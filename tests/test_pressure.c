@@ -1,0 +1,475 @@
+/* test_pressure.c: the hypre pressure solvers (PCG_BoomerAMG, PCG_diagonal)
+ * on the 2-D 5-point Poisson matrix with Dirichlet boundaries, whose
+ * spectrum is known: eigenvalues 4 - 2 cos(i pi h) - 2 cos(j pi h), h = 1/(n+1),
+ * so kappa = cot^2(pi h / 2). The error bound used below is the standard
+ * ||x - x*|| / ||x*|| <= kappa * ||b - A x|| / ||b||.
+ *
+ * Each rank builds its own block of rows, so the test also runs under
+ * `mpirun -np K` (meson runs it on one rank).
+ */
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <HYPRE_utilities.h>
+#include <mpi.h>
+
+#include "mf_test.h"
+/* Also the internal part, for the pattern fingerprint behind reuseSetup. */
+#define MF_PRESSURE_HYPRE_INTERNAL
+#include "pressure/pressure_hypre.h"
+
+static int rank = 0, nprocs = 1;
+
+/* ---- the test system ------------------------------------------------------ */
+
+typedef struct poisson {
+    mf_csr A;
+    double *x_exact, *b, *x;
+} poisson;
+
+/* This rank's block of rows of the n*n grid (row = i + n j), in CSR. */
+static void poisson_build(poisson *p, int n)
+{
+    const int64_t N = (int64_t)n * n;
+    const int64_t lo = N * rank / nprocs, hi = N * (rank + 1) / nprocs;
+    const size_t nrows = (size_t)(hi - lo);
+    memset(p, 0, sizeof *p);
+    p->A.nrows = nrows;
+    p->A.row_offset = lo;
+    p->A.nglobal = N;
+    p->A.rowptr = malloc((nrows + 1) * sizeof *p->A.rowptr);
+    p->A.col = malloc((5 * nrows + 1) * sizeof *p->A.col);
+    p->A.val = malloc((5 * nrows + 1) * sizeof *p->A.val);
+    p->x_exact = malloc((nrows + 1) * sizeof(double));
+    p->b = malloc((nrows + 1) * sizeof(double));
+    p->x = calloc(nrows + 1, sizeof(double));
+    if (!p->A.rowptr || !p->A.col || !p->A.val || !p->x_exact || !p->b || !p->x) {
+        fprintf(stderr, "out of memory\n");
+        MPI_Abort(MPI_COMM_WORLD, 1);
+    }
+    size_t k = 0;
+    for (size_t r = 0; r < nrows; r++) {
+        const int64_t g = lo + (int64_t)r;
+        const int i = (int)(g % n), j = (int)(g / n);
+        p->A.rowptr[r] = k;
+        /* Neighbours first and the diagonal in the middle: hypre must not
+         * depend on the diagonal coming first. */
+        if (j > 0) { p->A.col[k] = g - n; p->A.val[k++] = -1.0; }
+        if (i > 0) { p->A.col[k] = g - 1; p->A.val[k++] = -1.0; }
+        p->A.col[k] = g; p->A.val[k++] = 4.0;
+        if (i < n - 1) { p->A.col[k] = g + 1; p->A.val[k++] = -1.0; }
+        if (j < n - 1) { p->A.col[k] = g + n; p->A.val[k++] = -1.0; }
+        /* A smooth field plus a deterministic rough part: exercises all
+         * frequencies, not only the ones AMG finds easy. */
+        const double sx = (i + 1.0) / (n + 1.0), sy = (j + 1.0) / (n + 1.0);
+        uint64_t h = (uint64_t)g * 0x9E3779B97F4A7C15ull;
+        h ^= h >> 29;
+        const double noise = (double)(h % 2001) / 1000.0 - 1.0;
+        p->x_exact[r] = sin(3.0 * sx) * cos(2.0 * sy) + 0.3 * noise;
+    }
+    p->A.rowptr[nrows] = k;
+}
+
+static void poisson_free(poisson *p)
+{
+    free(p->A.rowptr);
+    free(p->A.col);
+    free(p->A.val);
+    free(p->x_exact);
+    free(p->b);
+    free(p->x);
+}
+
+static double global_sum(double local)
+{
+    double s = 0.0;
+    MPI_Allreduce(&local, &s, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+    return s;
+}
+
+/* b = A x_exact (x gathered from all ranks, fine for test sizes). */
+static void make_rhs(poisson *p)
+{
+    const int64_t N = p->A.nglobal;
+    double *xg = malloc((size_t)N * sizeof *xg);
+    int *counts = malloc((size_t)nprocs * sizeof *counts), *displs = malloc((size_t)nprocs * sizeof *displs);
+    for (int q = 0; q < nprocs; q++) {
+        displs[q] = (int)(N * q / nprocs);
+        counts[q] = (int)(N * (q + 1) / nprocs) - displs[q];
+    }
+    MPI_Allgatherv(p->x_exact, (int)p->A.nrows, MPI_DOUBLE, xg, counts, displs, MPI_DOUBLE,
+                   MPI_COMM_WORLD);
+    for (size_t r = 0; r < p->A.nrows; r++) {
+        double s = 0.0;
+        for (size_t k = p->A.rowptr[r]; k < p->A.rowptr[r + 1]; k++)
+            s += p->A.val[k] * xg[p->A.col[k]];
+        p->b[r] = s;
+    }
+    free(xg);
+    free(counts);
+    free(displs);
+}
+
+static double rel_error(const poisson *p)
+{
+    double e = 0.0, n = 0.0;
+    for (size_t r = 0; r < p->A.nrows; r++) {
+        e += (p->x[r] - p->x_exact[r]) * (p->x[r] - p->x_exact[r]);
+        n += p->x_exact[r] * p->x_exact[r];
+    }
+    return sqrt(global_sum(e) / global_sum(n));
+}
+
+static double kappa_poisson(int n)
+{
+    const double t = tan(M_PI / (2.0 * (n + 1)));
+    return 1.0 / (t * t);
+}
+
+/* ---- helpers for the modules ----------------------------------------------- */
+
+static void defaults(const mf_pressure_ops *ops, void *settings)
+{
+    memset(settings, 0, ops->info.settings_size);
+    CHECK_OK(mf_params_defaults(ops->info.params, ops->info.nparams, settings));
+}
+
+/* Create, solve once, destroy. */
+static int solve_once(const mf_pressure_ops *ops, const void *settings, poisson *p,
+                      mf_solve_report *rep)
+{
+    void *data = NULL;
+    int rc = ops->create(settings, &data);
+    if (rc != 0)
+        return rc;
+    rc = ops->solve(data, &p->A, p->b, p->x, rep);
+    ops->destroy(data);
+    return rc;
+}
+
+/* ---- tests ------------------------------------------------------------------- */
+
+static void test_tables(void)
+{
+    const mf_pressure_ops *all[] = {&mf_pressure_PCG_BoomerAMG, &mf_pressure_PCG_diagonal};
+    const char *names[] = {"PCG_BoomerAMG", "PCG_diagonal"};
+    for (int m = 0; m < 2; m++) {
+        const mf_module_info *info = &all[m]->info;
+        CHECK(info->abi_version == MF_ABI_VERSION);
+        CHECK(info->kind == MF_KIND_PRESSURE);
+        CHECK(strcmp(info->name, names[m]) == 0);
+        CHECK(info->summary && info->summary[0]);
+        CHECK(info->params && info->nparams >= 2);
+        CHECK(all[m]->create && all[m]->solve && all[m]->destroy);
+        /* Every default lies inside its declared range. */
+        char settings[256];
+        CHECK(info->settings_size <= sizeof settings);
+        defaults(all[m], settings);
+        for (size_t i = 0; i < info->nparams; i++) {
+            const mf_param *par = &info->params[i];
+            double v = par->type == MF_PARAM_SCALAR ? *(double *)(settings + par->offset)
+                                                    : (double)*(long *)(settings + par->offset);
+            CHECK_MSG(par->min > par->max || (v >= par->min && v <= par->max), "%s.%s = %g",
+                      info->name, par->name, v);
+            CHECK_MSG(par->doc && par->doc[0], "%s.%s has no doc", info->name, par->name);
+        }
+        void *data = NULL;
+        CHECK_OK(all[m]->create(settings, &data));
+        all[m]->destroy(data);
+    }
+    mf_pcg_boomeramg_settings s;
+    defaults(&mf_pressure_PCG_BoomerAMG, &s);
+    CHECK(s.coarsen_type == 10 && s.interp_type == 6 && s.p_max_elmts == 4 && s.relax_type == 8);
+    CHECK(s.strong_threshold == 0.25 && s.aggressive_levels == 1 && s.reuse_setup == 0);
+    CHECK(s.tolerance == 1e-8 && s.max_iter == 500);
+
+    /* A non-symmetric smoother would break PCG: refused at create. */
+    void *data = NULL;
+    s.relax_type = 3;
+    CHECK(mf_pressure_PCG_BoomerAMG.create(&s, &data) == MF_ERR_INPUT && data == NULL);
+    mf_error_clear();
+    mf_pcg_diagonal_settings ds = {.tolerance = 0.0, .max_iter = 10};
+    CHECK(mf_pressure_PCG_diagonal.create(&ds, &data) == MF_ERR_INPUT && data == NULL);
+    mf_error_clear();
+}
+
+/* Zero guess, tol 1e-10 on 64x64 (kappa ~ 1.7e3): the error bound
+ * kappa * 1e-10 ~ 2e-7 is below the asserted 1e-5 with room to spare. */
+static void test_accuracy(const mf_pressure_ops *ops, void *settings, double *tol)
+{
+    const int n = 64;
+    poisson p;
+    poisson_build(&p, n);
+    make_rhs(&p);
+    *tol = 1e-10;
+    mf_solve_report rep;
+    CHECK_OK(solve_once(ops, settings, &p, &rep));
+    const double err = rel_error(&p), kappa = kappa_poisson(n);
+    if (rank == 0)
+        printf("%-14s 64x64 tol 1e-10: %3d iterations, residual %.2e -> %.2e, error %.2e "
+               "(bound %.2e), setup %.4f s, solve %.4f s\n",
+               ops->info.name, rep.iterations, rep.initial_residual, rep.final_residual, err,
+               kappa * rep.final_residual, rep.setup_seconds, rep.solve_seconds);
+    CHECK(rep.converged);
+    CHECK(rep.iterations > 0);
+    CHECK_NEAR(rep.initial_residual, 1.0, 1e-14); /* zero guess: r0 = b */
+    CHECK(rep.final_residual <= 1e-10);
+    CHECK(err <= kappa * rep.final_residual * 1.01 + 1e-14);
+    CHECK(err <= 1e-5);
+    CHECK(rep.setup_seconds >= 0.0 && rep.solve_seconds >= 0.0);
+    CHECK(rep.setup_seconds + rep.solve_seconds < 60.0);
+    poisson_free(&p);
+}
+
+/* On 128x128 (kappa ~ 6.7e3) diagonal PCG needs hundreds of iterations;
+ * one V-cycle per iteration is nearly grid-independent (about 10). */
+static void test_amg_beats_diagonal(void)
+{
+    poisson p;
+    poisson_build(&p, 128);
+    make_rhs(&p);
+    mf_pcg_boomeramg_settings as;
+    defaults(&mf_pressure_PCG_BoomerAMG, &as);
+    mf_pcg_diagonal_settings ds;
+    defaults(&mf_pressure_PCG_diagonal, &ds);
+    ds.max_iter = 5000; /* the comparison must not hinge on the limit */
+    mf_solve_report ra, rd;
+    CHECK_OK(solve_once(&mf_pressure_PCG_BoomerAMG, &as, &p, &ra));
+    CHECK(rel_error(&p) <= kappa_poisson(128) * ra.final_residual * 1.01 + 1e-14);
+    memset(p.x, 0, p.A.nrows * sizeof *p.x);
+    CHECK_OK(solve_once(&mf_pressure_PCG_diagonal, &ds, &p, &rd));
+    if (rank == 0)
+        printf("128x128 tol 1e-8: PCG_BoomerAMG %d iterations (%.4f + %.4f s), PCG_diagonal %d "
+               "iterations (%.4f + %.4f s)\n",
+               ra.iterations, ra.setup_seconds, ra.solve_seconds, rd.iterations,
+               rd.setup_seconds, rd.solve_seconds);
+    CHECK(ra.converged && rd.converged);
+    CHECK(ra.final_residual <= 1e-8 && rd.final_residual <= 1e-8);
+    CHECK(ra.iterations < rd.iterations);
+    CHECK(ra.iterations <= 30);
+    CHECK(rd.iterations >= 100);
+    poisson_free(&p);
+}
+
+/* Too few iterations: MF_RETRY (recoverable) with the report filled. */
+static void test_not_converged(const mf_pressure_ops *ops, void *settings, long *max_iter)
+{
+    poisson p;
+    poisson_build(&p, 64);
+    make_rhs(&p);
+    *max_iter = 2;
+    mf_solve_report rep;
+    mf_error_clear();
+    int rc = solve_once(ops, settings, &p, &rep);
+    CHECK_MSG(rc == MF_RETRY, "%s returned %d", ops->info.name, rc);
+    CHECK(!rep.converged);
+    CHECK(rep.iterations == 2);
+    CHECK_NEAR(rep.initial_residual, 1.0, 1e-14);
+    CHECK(rep.final_residual > 1e-8 && rep.final_residual < 1.0);
+    CHECK(strstr(mf_error_message(), "not converged after 2 iterations") != NULL);
+    CHECK(strstr(mf_error_message(), ops->info.name) != NULL);
+    mf_error_clear();
+    *max_iter = 500;
+    poisson_free(&p);
+}
+
+/* b = 0: x = 0 exactly, whatever the guess, without iterating. */
+static void test_zero_rhs(const mf_pressure_ops *ops, const void *settings)
+{
+    poisson p;
+    poisson_build(&p, 16);
+    for (size_t r = 0; r < p.A.nrows; r++) {
+        p.b[r] = 0.0;
+        p.x[r] = 1.0 + (double)r;
+    }
+    mf_solve_report rep;
+    CHECK_OK(solve_once(ops, settings, &p, &rep));
+    bool zero = true;
+    for (size_t r = 0; r < p.A.nrows; r++)
+        zero = zero && p.x[r] == 0.0;
+    CHECK(zero);
+    CHECK(rep.iterations == 0 && rep.converged);
+    CHECK(rep.initial_residual == 0.0 && rep.final_residual == 0.0);
+    poisson_free(&p);
+}
+
+/* Starting from the exact solution: 0 or 1 iterations. */
+static void test_warm_start(const mf_pressure_ops *ops, const void *settings)
+{
+    poisson p;
+    poisson_build(&p, 64);
+    make_rhs(&p);
+    memcpy(p.x, p.x_exact, p.A.nrows * sizeof *p.x);
+    mf_solve_report rep;
+    CHECK_OK(solve_once(ops, settings, &p, &rep));
+    CHECK(rep.converged);
+    CHECK(rep.iterations <= 1);
+    CHECK(rep.initial_residual < 1e-14);
+    CHECK(rel_error(&p) < 1e-12);
+    poisson_free(&p);
+}
+
+/* reuseSetup: the same pattern with new values, a changed pattern, and
+ * values far from those the hierarchy was built for: all must converge. */
+static void test_reuse(void)
+{
+    mf_pcg_boomeramg_settings s;
+    defaults(&mf_pressure_PCG_BoomerAMG, &s);
+    s.reuse_setup = 3;
+    void *data = NULL;
+    CHECK_OK(mf_pressure_PCG_BoomerAMG.create(&s, &data));
+    mf_solve_report rep;
+    const double scales[] = {1.0, 1.5, 0.5};
+    int its[3] = {0, 0, 0};
+    poisson p;
+    poisson_build(&p, 64);
+    for (int t = 0; t < 3; t++) {
+        /* Scale the matrix; same pattern, so the hierarchy is reused. */
+        for (size_t k = 0; k < p.A.rowptr[p.A.nrows]; k++)
+            p.A.val[k] *= t == 0 ? 1.0 : scales[t] / scales[t - 1];
+        make_rhs(&p);
+        memset(p.x, 0, p.A.nrows * sizeof *p.x);
+        CHECK_OK(mf_pressure_PCG_BoomerAMG.solve(data, &p.A, p.b, p.x, &rep));
+        CHECK(rep.converged && rep.final_residual <= 1e-8);
+        CHECK(rel_error(&p) <= kappa_poisson(64) * rep.final_residual * 1.01 + 1e-14);
+        its[t] = rep.iterations;
+    }
+    if (rank == 0)
+        printf("reuseSetup: %d, %d, %d iterations\n", its[0], its[1], its[2]);
+
+    /* A diagonal shift of 20: the kept hierarchy (with its l1 norms) no
+     * longer fits; whatever happens inside, the answer must be right. */
+    for (size_t r = 0; r < p.A.nrows; r++)
+        for (size_t k = p.A.rowptr[r]; k < p.A.rowptr[r + 1]; k++)
+            if (p.A.col[k] == p.A.row_offset + (int64_t)r)
+                p.A.val[k] += 20.0;
+    make_rhs(&p);
+    memset(p.x, 0, p.A.nrows * sizeof *p.x);
+    CHECK_OK(mf_pressure_PCG_BoomerAMG.solve(data, &p.A, p.b, p.x, &rep));
+    CHECK(rep.converged && rel_error(&p) < 1e-6);
+    poisson_free(&p);
+
+    /* A new size: a new hierarchy. */
+    poisson_build(&p, 48);
+    make_rhs(&p);
+    CHECK_OK(mf_pressure_PCG_BoomerAMG.solve(data, &p.A, p.b, p.x, &rep));
+    CHECK(rep.converged && rel_error(&p) <= kappa_poisson(48) * rep.final_residual * 1.01 + 1e-14);
+    poisson_free(&p);
+    mf_pressure_PCG_BoomerAMG.destroy(data);
+}
+
+/* The fingerprint that decides reuse: blind to values, not to the pattern. */
+static void test_pattern_hash(void)
+{
+    poisson p, q;
+    poisson_build(&p, 16);
+    poisson_build(&q, 17);
+    uint64_t h0, h1, h2, h3;
+    CHECK_OK(mf_hypre_pattern_hash(&p.A, &h0));
+    for (size_t k = 0; k < p.A.rowptr[p.A.nrows]; k++)
+        p.A.val[k] *= 3.0;
+    CHECK_OK(mf_hypre_pattern_hash(&p.A, &h1));
+    CHECK(h1 == h0);
+    /* Move one off-diagonal entry of the last row to another column. */
+    const size_t last = p.A.rowptr[p.A.nrows] - 1;
+    const int64_t saved = p.A.col[last];
+    p.A.col[last] = p.A.col[last] == 0 ? 1 : 0;
+    CHECK_OK(mf_hypre_pattern_hash(&p.A, &h2));
+    CHECK(h2 != h0);
+    p.A.col[last] = saved;
+    CHECK_OK(mf_hypre_pattern_hash(&q.A, &h3));
+    CHECK(h3 != h0);
+    poisson_free(&p);
+    poisson_free(&q);
+}
+
+/* Bad input: clear errors, nothing from hypre. */
+static void test_bad_input(void)
+{
+    mf_pcg_diagonal_settings ds;
+    defaults(&mf_pressure_PCG_diagonal, &ds);
+    mf_pcg_boomeramg_settings as;
+    defaults(&mf_pressure_PCG_BoomerAMG, &as);
+    mf_solve_report rep;
+    poisson p;
+    poisson_build(&p, 8);
+    make_rhs(&p);
+
+    /* A column outside the matrix (on rank 0; the other ranks agree to fail). */
+    int64_t saved = p.A.col[0];
+    if (rank == 0)
+        p.A.col[0] = p.A.nglobal + 5;
+    mf_error_clear();
+    CHECK(solve_once(&mf_pressure_PCG_BoomerAMG, &as, &p, &rep) == MF_ERR_INPUT);
+    if (rank == 0)
+        CHECK(strstr(mf_error_message(), "outside") != NULL);
+    mf_error_clear();
+    p.A.col[0] = saved;
+
+    /* More rows than a 32-bit HYPRE_BigInt holds. */
+    if (sizeof(HYPRE_BigInt) == 4 && nprocs == 1) {
+        mf_csr big = p.A;
+        big.nglobal = (int64_t)1 << 33;
+        CHECK(solve_once(&mf_pressure_PCG_diagonal, &ds, &(poisson){.A = big, .b = p.b, .x = p.x},
+                         &rep) == MF_ERR_INPUT);
+        CHECK(strstr(mf_error_message(), "HYPRE_BigInt") != NULL);
+        mf_error_clear();
+    }
+
+    /* NaN in the right-hand side. */
+    double b0 = p.b[0];
+    if (rank == 0)
+        p.b[0] = NAN;
+    CHECK(solve_once(&mf_pressure_PCG_diagonal, &ds, &p, &rep) == MF_ERR_NUMERIC);
+    mf_error_clear();
+    p.b[0] = b0;
+
+    /* A zero diagonal entry: diagonal scaling cannot work. */
+    for (size_t k = p.A.rowptr[0]; k < p.A.rowptr[1]; k++)
+        if (p.A.col[k] == p.A.row_offset)
+            p.A.val[k] = 0.0;
+    memset(p.x, 0, p.A.nrows * sizeof *p.x);
+    int rc = solve_once(&mf_pressure_PCG_diagonal, &ds, &p, &rep);
+    CHECK_MSG(rc == MF_ERR_NUMERIC, "rc %d", rc);
+    mf_error_clear();
+    poisson_free(&p);
+}
+
+int main(int argc, char **argv)
+{
+    MPI_Init(&argc, &argv);
+    HYPRE_Init();
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    MPI_Comm_size(MPI_COMM_WORLD, &nprocs);
+
+    test_tables();
+
+    mf_pcg_boomeramg_settings as;
+    defaults(&mf_pressure_PCG_BoomerAMG, &as);
+    mf_pcg_diagonal_settings ds;
+    defaults(&mf_pressure_PCG_diagonal, &ds);
+
+    test_accuracy(&mf_pressure_PCG_BoomerAMG, &as, &as.tolerance);
+    test_accuracy(&mf_pressure_PCG_diagonal, &ds, &ds.tolerance);
+    as.tolerance = ds.tolerance = 1e-8;
+    test_amg_beats_diagonal();
+    test_not_converged(&mf_pressure_PCG_BoomerAMG, &as, &as.max_iter);
+    test_not_converged(&mf_pressure_PCG_diagonal, &ds, &ds.max_iter);
+    test_zero_rhs(&mf_pressure_PCG_BoomerAMG, &as);
+    test_zero_rhs(&mf_pressure_PCG_diagonal, &ds);
+    test_warm_start(&mf_pressure_PCG_BoomerAMG, &as);
+    test_warm_start(&mf_pressure_PCG_diagonal, &ds);
+    test_reuse();
+    test_pattern_hash();
+    test_bad_input();
+
+    int status = mf_test_summary("pressure");
+    /* Fail on every rank if any rank failed. */
+    int any = status != EXIT_SUCCESS, all = 0;
+    MPI_Allreduce(&any, &all, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+    HYPRE_Finalize();
+    MPI_Finalize();
+    return all ? EXIT_FAILURE : EXIT_SUCCESS;
+}
