@@ -19,6 +19,7 @@ typedef struct mf_run_control {
     double delta_t;      /* first (or fixed) step */
     bool adjust;         /* choose dt from the limits */
     double max_co, max_di, max_delta_t;
+    double min_delta_t;  /* below this an adjustable step means the run went unstable */
     bool write_by_steps; /* writeControl timeStep */
     double write_interval;
     long max_retries;
@@ -35,6 +36,7 @@ typedef struct mf_run {
     mf_module *functions;            /* function objects */
     const mf_dict *params;           /* resolved case, handed to the writer */
     /* Filled by the loop. */
+    double natural_dt;  /* last step the limits allowed, before landing on a write time */
     long steps, retries;
     double wall_seconds;
     int writes;

@@ -131,6 +131,34 @@ static double max_fluid_nu(const mf_sim *sim)
     return nu;
 }
 
+/* The step fell below its floor: name the fastest particle, which is
+ * nearly always where a run goes unstable. */
+static int diagnose_collapse(const mf_sim *sim, double dt, double floor_dt, const char *limiter)
+{
+    const mf_particles *p = sim->p;
+    size_t fastest = 0;
+    double u2max = -1;
+    for (size_t i = 0; i < p->n_owned; i++) {
+        const double *v = &p->vel[3 * i];
+        double u2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        if (u2 > u2max) {
+            u2max = u2;
+            fastest = i;
+        }
+    }
+    const double *x = &p->pos[3 * fastest];
+    return MF_ERROR(MF_ERR_NUMERIC,
+                    "unstable: the time step fell to %g s (%s limit), below minDeltaT %g s, at "
+                    "time %g: particle id %lld at (%g %g %g) moves at %g m/s. A pressure "
+                    "spike feeds back through the Courant limit: try relaxation 0.2, the "
+                    "collision model, or a fixed deltaT",
+                    dt, limiter, floor_dt, sim->time, (long long)p->id[fastest], x[0], x[1],
+                    x[2], sqrt(u2max));
+}
+
+/* The step the limits allow ("natural"), then shortened to land on the next
+ * write time or the end. Growth is limited relative to the last natural
+ * step, so a sliver taken to land on a write time does not hold dt down. */
 static int choose_dt(mf_run *run, double next_write, double *dt, const char **limiter)
 {
     mf_sim *sim = run->sim;
@@ -142,34 +170,38 @@ static int choose_dt(mf_run *run, double next_write, double *dt, const char **li
         mf_dt_choice ch;
         mf_dt_choose(sim->l0, mf_max_fluid_speed(sim->p), c->max_co, max_fluid_nu(sim),
                      c->max_di, c->max_delta_t, &ch);
-        *dt = ch.dt;
+        double natural = ch.dt;
         *limiter = ch.limiter;
-        /* Grow at most 20% a step from the last (OpenFOAM's damping), start at deltaT. */
-        double last = sim->step == 0 || sim->dt <= 0 ? c->delta_t : sim->dt;
-        if (*dt > 1.2 * last) {
-            *dt = 1.2 * last;
+        /* Start at deltaT, grow at most 20% a step (OpenFOAM's damping). */
+        double last = run->natural_dt > 0 ? run->natural_dt : c->delta_t;
+        if (natural > 1.2 * last) {
+            natural = 1.2 * last;
             *limiter = "growth";
         }
         if (run->solver_ops->stable_dt) {
             double sdt = INFINITY;
             MF_CALL(run->solver_ops->stable_dt(run->solver->data, sim, &sdt));
-            if (sdt < *dt) {
-                *dt = sdt;
+            if (sdt < natural) {
+                natural = sdt;
                 *limiter = "solver";
             }
         }
+        run->natural_dt = natural;
+        *dt = natural;
         /* Land on write times and the end time (adjustableRunTime). */
         double target = sim->end_time;
         if (!c->write_by_steps && next_write < target)
             target = next_write;
         double left = target - sim->time;
-        if (left > 0 && *dt > left * (1 - 1e-9))
+        if (left > 0 && *dt >= left * (1 - 1e-9))
             *dt = left;
-        else if (left > 0 && *dt > 0.5 * left && *dt < left)
+        else if (left > 0 && *dt > 0.5 * left)
             *dt = 0.5 * left; /* two even steps rather than a sliver */
     }
     if (!(*dt > 0) || !isfinite(*dt))
         return MF_ERROR(MF_ERR_NUMERIC, "the time step became %g at time %g", *dt, sim->time);
+    if (c->adjust && *dt < c->min_delta_t && run->natural_dt < c->min_delta_t)
+        return diagnose_collapse(sim, *dt, c->min_delta_t, *limiter);
     return 0;
 }
 
@@ -190,8 +222,8 @@ static int write_now(mf_run *run)
 static int step_once(mf_run *run, saved_state *saved, double next_write)
 {
     mf_sim *sim = run->sim;
-    double dt;
-    const char *limiter;
+    double dt = 0;
+    const char *limiter = NULL;
     MF_CALL(choose_dt(run, next_write, &dt, &limiter));
     MF_CALL(save_state(saved, sim->p, sim->time));
     for (long attempt = 0;; attempt++) {
@@ -222,6 +254,7 @@ static int step_once(mf_run *run, saved_state *saved, double next_write)
         sim->time = saved->time;
         run->retries++;
         dt *= 0.5;
+        run->natural_dt = dt;
     }
     (void)limiter;
     sim->time += dt;

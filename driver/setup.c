@@ -221,6 +221,7 @@ int mf_app_setup(mf_app *app)
     run->ctl.max_co = c->max_co;
     run->ctl.max_di = c->max_di;
     run->ctl.max_delta_t = c->max_delta_t;
+    run->ctl.min_delta_t = c->min_delta_t;
     run->ctl.write_by_steps = strcmp(c->write_control, "timeStep") == 0;
     run->ctl.write_interval = c->write_interval;
     run->ctl.max_retries = c->max_retries;

@@ -31,6 +31,8 @@ const mf_param mf_control_params[] = {
      "largest viscous number nu dt / l0^2 (0: no viscous limit)"},
     {"maxDeltaT", MF_PARAM_SCALAR, "1", 1e-15, 1e30, NULL, offsetof(mf_control, max_delta_t),
      "largest time step, s"},
+    {"minDeltaT", MF_PARAM_SCALAR, "1e-8", 0, 1e30, NULL, offsetof(mf_control, min_delta_t),
+     "an adjustable step below this stops the run as unstable, s"},
     {"writeControl", MF_PARAM_WORD, "adjustableRunTime", MF_NO_RANGE, write_controls,
      offsetof(mf_control, write_control), "writeInterval in seconds or in steps"},
     {"writeInterval", MF_PARAM_SCALAR, NULL, 1e-15, 1e30, NULL,

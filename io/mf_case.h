@@ -23,6 +23,7 @@ typedef struct mf_control {
     double max_co;
     double max_di;       /* viscous number nu dt / l0^2 */
     double max_delta_t;
+    double min_delta_t;
     const char *write_control; /* adjustableRunTime | timeStep */
     double write_interval;
     const char *writer;  /* writer module name */
