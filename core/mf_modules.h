@@ -28,6 +28,8 @@ typedef struct mf_solver_ops {
     void (*destroy)(void *data);
     /* Optional: the largest stable dt the module knows of (viscous limit...). */
     int (*stable_dt)(void *data, const mf_sim *sim, double *dt);
+    /* Optional: print where the time went (benchmarks, end of a run). */
+    void (*report)(void *data, const mf_sim *sim, mf_log *log);
 } mf_solver_ops;
 
 /* ---- pressure: solves the (symmetric positive definite) PPE ------------- */

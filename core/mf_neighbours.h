@@ -59,7 +59,7 @@ typedef struct mf_nlist {
     size_t *start;         /* n + 1 */
     uint32_t *j;           /* start[n] entries */
     size_t cap_n, cap_j;
-    void *work;            /* scratch of build and filter, reused (added) */
+    void *work;            /* scratch of mf_nlist_build (candidate bits), reused (added) */
     size_t work_bytes;
 } mf_nlist;
 

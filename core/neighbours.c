@@ -32,6 +32,14 @@
 
 #include "mf_error.h"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+/* The kernels take dim and keep_bits as arguments but are called with
+ * literals; forced inlining makes each combination its own branch-free loop. */
+#define KERNEL static inline __attribute__((always_inline))
+
 #define EMPTY_SLOT UINT32_MAX
 #define AXIS_LIMIT ((uint64_t)1 << MF_GRID_AXIS_BITS)
 #define AXIS_MASK (AXIS_LIMIT - 1)
@@ -304,12 +312,24 @@ static void find_rows(const mf_grid *g, size_t c, uint32_t *rows)
                 continue;
             const uint64_t y = iy + (uint64_t)(int64_t)dy, z = iz + (uint64_t)(int64_t)dz;
             long first = -1, last = -1;
-            for (uint64_t x = x0; x <= x1; x++) {
-                long cell = mf_grid_find_cell(g, mf_grid_key(x, y, z));
-                if (cell >= 0) {
-                    if (first < 0)
-                        first = cell;
-                    last = cell;
+            const uint64_t mid_key = mf_grid_key(ix, y, z);
+            long mid = dy == 0 && dz == 0 ? (long)c : mf_grid_find_cell(g, mid_key);
+            if (mid >= 0) {
+                /* Cells are sorted by key: the x-neighbours of an occupied
+                 * cell, if occupied, are the cells next to it. */
+                first = last = mid;
+                if (x0 < ix && mid > 0 && g->cell_key[mid - 1] == mid_key - 1)
+                    first = mid - 1;
+                if (x1 > ix && (size_t)mid + 1 < g->ncells && g->cell_key[mid + 1] == mid_key + 1)
+                    last = mid + 1;
+            } else {
+                for (uint64_t x = x0; x <= x1; x++) {
+                    long cell = x == ix ? -1 : mf_grid_find_cell(g, mf_grid_key(x, y, z));
+                    if (cell >= 0) {
+                        if (first < 0)
+                            first = cell;
+                        last = cell;
+                    }
                 }
             }
             if (first >= 0) {
@@ -349,12 +369,13 @@ static int bounding_box(const mf_particles *p, size_t n, double lo[3], double hi
         double z = dim == 3 ? x[2] : 0.0;
         if (!isfinite(x[0]) || !isfinite(x[1]) || !isfinite(z))
             bad++;
-        x0 = fmin(x0, x[0]);
-        x1 = fmax(x1, x[0]);
-        y0 = fmin(y0, x[1]);
-        y1 = fmax(y1, x[1]);
-        z0 = fmin(z0, z);
-        z1 = fmax(z1, z);
+        /* Not fmin/fmax: those are library calls at -O2. */
+        x0 = x[0] < x0 ? x[0] : x0;
+        x1 = x[0] > x1 ? x[0] : x1;
+        y0 = x[1] < y0 ? x[1] : y0;
+        y1 = x[1] > y1 ? x[1] : y1;
+        z0 = z < z0 ? z : z0;
+        z1 = z > z1 ? z : z1;
     }
     if (bad) {
         for (size_t i = 0; i < n; i++) {
@@ -638,7 +659,7 @@ static inline vec2d splat2(double x)
 }
 
 /* Candidates m, m + 1 closer than the radius: lanes -1 (in) or 0 (out). */
-static inline vec2i within2(const pair_test *t, size_t m, const double xi[3], int dim)
+KERNEL vec2i within2(const pair_test *t, size_t m, const double xi[3], int dim)
 {
     vec2d dx = load2(t->sx + m) - splat2(xi[0]);
     vec2d dy = load2(t->sy + m) - splat2(xi[1]);
@@ -650,7 +671,17 @@ static inline vec2i within2(const pair_test *t, size_t m, const double xi[3], in
     return d2 < splat2(t->r2);
 }
 
-static inline bool within1(const pair_test *t, size_t m, const double xi[3], int dim)
+/* The two lanes of a test as bits 0 and 1. */
+static inline unsigned lane_bits(vec2i h)
+{
+#if defined(__SSE2__)
+    return (unsigned)_mm_movemask_pd((__m128d)h); /* one instruction */
+#else
+    return (unsigned)((h[0] & 1) | (h[1] & 2));
+#endif
+}
+
+KERNEL bool within1(const pair_test *t, size_t m, const double xi[3], int dim)
 {
     double dx = t->sx[m] - xi[0], dy = t->sy[m] - xi[1];
     double d2 = dx * dx + dy * dy;
@@ -661,21 +692,29 @@ static inline bool within1(const pair_test *t, size_t m, const double xi[3], int
     return d2 < t->r2;
 }
 
-/* Candidate bits of a cell's particles: each row starts at an even bit (the
- * tests come in pairs), each particle at a word. */
-static size_t candidate_bits(const uint32_t *rows, int nrows)
+/* Candidate bits: a particle's bits start at a word, and each row at an even
+ * bit (the tests come in pairs). row_bit[r] is the first bit of row r,
+ * row_bit[nrows] the total. */
+static void row_bit_offsets(const uint32_t *rows, int nrows, size_t row_bit[MAX_ROWS + 1])
 {
-    size_t bits = 0;
+    row_bit[0] = 0;
     for (int r = 0; r < nrows; r++)
-        bits += ((size_t)(rows[2 * r + 1] - rows[2 * r]) + 1) & ~(size_t)1;
-    return bits;
+        row_bit[r + 1] = row_bit[r] + (((size_t)(rows[2 * r + 1] - rows[2 * r]) + 1) & ~(size_t)1);
 }
 
-/* Test every candidate of sorted particle k (position xi); store the
- * outcomes as bits in words (if not NULL). Returns the count of hits, the
- * particle itself included (its distance 0 is < r2). */
-static inline size_t test_candidates(const pair_test *t, const uint32_t *rows, int nrows,
-                                     const double xi[3], int dim, uint64_t *words)
+static size_t words_per_particle(const uint32_t *rows, int nrows)
+{
+    size_t row_bit[MAX_ROWS + 1];
+    row_bit_offsets(rows, nrows, row_bit);
+    return (row_bit[nrows] + 63) / 64;
+}
+
+/* Test every candidate of sorted particle k (position xi); with keep_bits,
+ * store the outcomes as bits in words. Returns the count of hits, the
+ * particle itself included (its distance 0 is < r2). dim and keep_bits are
+ * literals at the call sites, so each combination compiles to its own loop. */
+KERNEL size_t test_candidates(const pair_test *t, const uint32_t *rows, int nrows,
+                              const double xi[3], int dim, bool keep_bits, uint64_t *words)
 {
     vec2i hits = {0, 0};
     uint64_t acc = 0;
@@ -686,8 +725,8 @@ static inline size_t test_candidates(const pair_test *t, const uint32_t *rows, i
         for (; m + 2 <= b; m += 2) {
             vec2i h = within2(t, m, xi, dim);
             hits -= h;
-            if (words) {
-                acc |= (uint64_t)((h[0] & 1) | (h[1] & 2)) << bit;
+            if (keep_bits) {
+                acc |= (uint64_t)lane_bits(h) << bit;
                 bit += 2;
                 if (bit == 64) {
                     *words++ = acc;
@@ -699,7 +738,7 @@ static inline size_t test_candidates(const pair_test *t, const uint32_t *rows, i
         if (m < b) {
             uint64_t h = within1(t, m, xi, dim);
             hits[0] += (int64_t)h;
-            if (words) {
+            if (keep_bits) {
                 acc |= h << bit;
                 bit += 2;
                 if (bit == 64) {
@@ -710,19 +749,16 @@ static inline size_t test_candidates(const pair_test *t, const uint32_t *rows, i
             }
         }
     }
-    if (words && bit)
+    if (keep_bits && bit)
         *words = acc;
     return (size_t)(hits[0] + hits[1]);
 }
 
 /* Append the particle indices of the set bits (other than k itself). */
-static inline size_t decode_bits(const uint64_t *words, size_t nwords, const uint32_t *rows,
-                                 int nrows, const size_t *order, size_t k, uint32_t *out)
+KERNEL size_t decode_bits(const uint64_t *words, size_t nwords, const uint32_t *rows,
+                          const size_t row_bit[MAX_ROWS + 1], const size_t *order, size_t k,
+                          uint32_t *out)
 {
-    size_t row_bit[MAX_ROWS + 1]; /* first bit of each row */
-    row_bit[0] = 0;
-    for (int r = 0; r < nrows; r++)
-        row_bit[r + 1] = row_bit[r] + (((size_t)(rows[2 * r + 1] - rows[2 * r]) + 1) & ~(size_t)1);
     size_t w = 0;
     int r = 0;
     for (size_t wi = 0; wi < nwords; wi++) {
@@ -741,9 +777,9 @@ static inline size_t decode_bits(const uint64_t *words, size_t nwords, const uin
 }
 
 /* Fallback fill without bits: repeat the distance test. */
-static inline size_t retest_candidates(const pair_test *t, const uint32_t *rows, int nrows,
-                                       const size_t *order, size_t k, const double xi[3],
-                                       int dim, uint32_t *out)
+KERNEL size_t retest_candidates(const pair_test *t, const uint32_t *rows, int nrows,
+                                const size_t *order, size_t k, const double xi[3], int dim,
+                                uint32_t *out)
 {
     size_t w = 0;
     for (int r = 0; r < nrows; r++) {
@@ -773,21 +809,21 @@ typedef struct {
 } list_build;
 
 /* Pass 1: start[i + 1] = number of neighbours of i; bits if kept. */
-static void count_cell(const list_build *lb, size_t c, int dim, size_t *start)
+KERNEL void count_cell(const list_build *lb, size_t c, int dim, bool keep_bits, size_t *start)
 {
     const mf_grid *g = lb->g;
     const uint32_t *rows = g->cell_rows + (size_t)c * 2 * lb->nrows;
     const size_t k0 = g->cell_start[c], k1 = g->cell_start[c + 1];
     uint64_t *words = NULL;
     size_t nwords = 0;
-    if (lb->cell_word) {
+    if (keep_bits) {
         words = lb->bits + lb->cell_word[c];
         nwords = (lb->cell_word[c + 1] - lb->cell_word[c]) / (k1 - k0);
     }
     for (size_t k = k0; k < k1; k++) {
         const double xi[3] = {lb->t.sx[k], lb->t.sy[k], lb->t.sz[k]};
-        size_t hits = test_candidates(&lb->t, rows, lb->nrows, xi, dim,
-                                      words ? words + (k - k0) * nwords : NULL);
+        size_t hits = test_candidates(&lb->t, rows, lb->nrows, xi, dim, keep_bits,
+                                      keep_bits ? words + (k - k0) * nwords : NULL);
         start[g->order[k] + 1] = hits - 1; /* minus the particle itself */
     }
 }
@@ -796,29 +832,38 @@ static void count_pass(const list_build *lb, size_t *start)
 {
     const size_t ncells = lb->g->ncells;
     const int dim = lb->g->dim;
+    const bool keep_bits = lb->cell_word != NULL;
 #pragma omp parallel for schedule(dynamic, 32)
     for (size_t c = 0; c < ncells; c++) {
-        /* Literal dims let the compiler specialise the kernels. */
-        if (dim == 3)
-            count_cell(lb, c, 3, start);
+        /* Literals let the compiler specialise the kernels. */
+        if (dim == 3 && keep_bits)
+            count_cell(lb, c, 3, true, start);
+        else if (dim == 3)
+            count_cell(lb, c, 3, false, start);
+        else if (keep_bits)
+            count_cell(lb, c, 2, true, start);
         else
-            count_cell(lb, c, 2, start);
+            count_cell(lb, c, 2, false, start);
     }
 }
 
 /* Pass 2: j's at the offsets of pass 1, from the bits or by testing again. */
-static void fill_cell(const list_build *lb, size_t c, int dim, const size_t *start,
+KERNEL void fill_cell(const list_build *lb, size_t c, int dim, const size_t *start,
                       uint32_t *jlist)
 {
     const mf_grid *g = lb->g;
     const uint32_t *rows = g->cell_rows + (size_t)c * 2 * lb->nrows;
     const size_t k0 = g->cell_start[c], k1 = g->cell_start[c + 1];
+    size_t row_bit[MAX_ROWS + 1], nwords = 0;
+    if (lb->cell_word) {
+        row_bit_offsets(rows, lb->nrows, row_bit);
+        nwords = (lb->cell_word[c + 1] - lb->cell_word[c]) / (k1 - k0);
+    }
     for (size_t k = k0; k < k1; k++) {
         uint32_t *out = jlist + start[g->order[k]];
         if (lb->cell_word) {
-            size_t nwords = (lb->cell_word[c + 1] - lb->cell_word[c]) / (k1 - k0);
             const uint64_t *words = lb->bits + lb->cell_word[c] + (k - k0) * nwords;
-            decode_bits(words, nwords, rows, lb->nrows, g->order, k, out);
+            decode_bits(words, nwords, rows, row_bit, g->order, k, out);
         } else {
             const double xi[3] = {lb->t.sx[k], lb->t.sy[k], lb->t.sz[k]};
             retest_candidates(&lb->t, rows, lb->nrows, g->order, k, xi, dim, out);
@@ -849,8 +894,7 @@ static int plan_bits(mf_nlist *nl, list_build *lb)
     size_t total = 0;
     for (size_t c = 0; c < ncells; c++) {
         const uint32_t *rows = g->cell_rows + c * 2 * lb->nrows;
-        size_t words = (candidate_bits(rows, lb->nrows) + 63) / 64;
-        total += words * (g->cell_start[c + 1] - g->cell_start[c]);
+        total += words_per_particle(rows, lb->nrows) * (g->cell_start[c + 1] - g->cell_start[c]);
     }
     lb->cell_word = NULL;
     lb->bits = NULL;
@@ -862,8 +906,7 @@ static int plan_bits(mf_nlist *nl, list_build *lb)
     for (size_t c = 0; c < ncells; c++) {
         const uint32_t *rows = g->cell_rows + c * 2 * lb->nrows;
         cell_word[c] = offset;
-        offset += (candidate_bits(rows, lb->nrows) + 63) / 64 *
-                  (g->cell_start[c + 1] - g->cell_start[c]);
+        offset += words_per_particle(rows, lb->nrows) * (g->cell_start[c + 1] - g->cell_start[c]);
     }
     cell_word[ncells] = offset;
     lb->cell_word = cell_word;
@@ -923,7 +966,7 @@ int mf_nlist_filter(mf_nlist *nl, const mf_nlist *from, const mf_particles *p, d
     if (!nl || !from || !p)
         return MF_ERROR(MF_ERR_INPUT, "mf_nlist_filter: NULL list or particles");
     if (nl == from)
-        return MF_ERROR(MF_ERR_INPUT, "mf_nlist_filter: the output list must differ from the input");
+        return MF_ERROR(MF_ERR_INPUT, "mf_nlist_filter: output and input lists must differ");
     if (!(radius * radius > 0.0) || radius > from->radius)
         return MF_ERROR(MF_ERR_INPUT,
                         "filter radius %g must be positive and at most the list radius %g",
@@ -932,26 +975,19 @@ int mf_nlist_filter(mf_nlist *nl, const mf_nlist *from, const mf_particles *p, d
         return MF_ERROR(MF_ERR_INPUT, "neighbour list covers %zu particles, the store holds %zu",
                         from->n, p->n);
     const size_t n = from->n;
-    const size_t entries = from->start[n];
     MF_CALL(ensure_start(nl, n));
-    /* One byte per entry of `from` keeps the test outcome for the fill: the
-     * positions are read once. */
-    MF_CALL(ensure_work(nl, entries > 0 ? entries : 1));
     nl->n = 0;
     nl->radius = radius;
     const double r2 = radius * radius;
     const double *pos = p->pos;
     const int dim = p->dim;
     size_t *start = nl->start;
-    uint8_t *keep = nl->work;
 
 #pragma omp parallel for schedule(dynamic, 256)
     for (size_t i = 0; i < n; i++) {
         size_t count = 0;
-        for (size_t e = from->start[i]; e < from->start[i + 1]; e++) {
-            keep[e] = distance2(pos, dim, i, from->j[e]) < r2;
-            count += keep[e];
-        }
+        for (size_t e = from->start[i]; e < from->start[i + 1]; e++)
+            count += distance2(pos, dim, i, from->j[e]) < r2;
         start[i + 1] = count;
     }
     counts_to_offsets(start, n);
@@ -961,7 +997,9 @@ int mf_nlist_filter(mf_nlist *nl, const mf_nlist *from, const mf_particles *p, d
     for (size_t i = 0; i < n; i++) {
         uint32_t *out = jlist + start[i];
         for (size_t e = from->start[i]; e < from->start[i + 1]; e++)
-            if (keep[e])
+            /* Testing again is as fast as keeping a byte per entry of `from`,
+             * and needs no memory. */
+            if (distance2(pos, dim, i, from->j[e]) < r2)
                 *out++ = from->j[e];
     }
     nl->n = n;

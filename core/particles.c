@@ -123,8 +123,9 @@ int mf_particles_reserve(mf_particles *p, size_t cap)
             return MF_ERROR(MF_ERR_MEMORY, "particle capacity %zu is too large", new_cap);
         void *grown = realloc(*refs[a].data, bytes);
         if (!grown)
-            return MF_ERROR(MF_ERR_MEMORY, "cannot grow particle arrays to %zu particles (%zu bytes)",
-                            new_cap, bytes);
+            return MF_ERROR(MF_ERR_MEMORY,
+                            "cannot grow particle arrays to %zu particles (%zu bytes)", new_cap,
+                            bytes);
         *refs[a].data = grown;
         if (a >= 4) { /* optional fields start at zero */
             size_t old_bytes = p->cap * refs[a].elem_size;

@@ -157,6 +157,9 @@ int mf_cmd_run(mf_app *app)
     MF_CALL(mf_case_write_resolved(&app->cs));
     mf_app_summary(app);
     int rc = mf_run_loop(&app->run, !restart);
+    const mf_solver_ops *ops = (const mf_solver_ops *)app->solver.info;
+    if (ops->report)
+        ops->report(app->solver.data, &app->sim, &app->log);
     mf_log_printf(&app->log, MF_LOG_QUIET,
                   "\nSteps %ld (retried %ld), snapshots %d, wall time %.2f s, peak memory %.1f "
                   "MB\n",

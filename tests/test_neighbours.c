@@ -121,7 +121,8 @@ static size_t compare_with_brute_force(const mf_nlist *nl, const mf_particles *p
         bool same = ng == nw && memcmp(got, want, nw * sizeof *got) == 0;
         if (!same) {
             if (bad < 5)
-                fprintf(stderr, "%s: particle %zu at (%g, %g, %g): %zu neighbours, brute force %zu\n",
+                fprintf(stderr,
+                        "%s: particle %zu at (%g, %g, %g): %zu neighbours, brute force %zu\n",
                         what, i, p->pos[3 * i], p->pos[3 * i + 1], p->pos[3 * i + 2], ng, nw);
             bad++;
         }

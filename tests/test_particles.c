@@ -28,10 +28,10 @@ static size_t count_mismatches(const mf_particles *p, const fields *f)
     size_t bad = 0;
     for (size_t i = 0; i < p->n; i++) {
         double id = (double)p->id[i];
+        const double *x = p->pos + 3 * i, *v = p->vel + 3 * i;
         bool ok = mf_particles_fd(p, f->scalar)[i] == id &&
-                  mf_particles_fi(p, f->integer)[i] == (int32_t)p->id[i] &&
-                  p->pos[3 * i] == id && p->pos[3 * i + 1] == -id && p->pos[3 * i + 2] == 0.5 * id &&
-                  p->vel[3 * i] == 2 * id && p->vel[3 * i + 1] == 0 && p->vel[3 * i + 2] == -id &&
+                  mf_particles_fi(p, f->integer)[i] == (int32_t)p->id[i] && x[0] == id &&
+                  x[1] == -id && x[2] == 0.5 * id && v[0] == 2 * id && v[1] == 0 && v[2] == -id &&
                   p->kind[i] == p->id[i] % MF_NKINDS;
         for (int d = 0; d < 3; d++)
             ok = ok && mf_particles_fd(p, f->vector)[3 * i + d] == (d + 1) * id;

@@ -59,6 +59,7 @@ typedef struct mps_data {
     mf_solve_report last;
     long ppe_rows;
     double t_neighbours, t_explicit, t_assembly, t_solve, t_correction;
+    double t_setup, t_pcg; /* parts of t_solve, as the pressure module reports them */
 } mps_data;
 
 enum { MPS_FLAG_SURFACE = 1 }; /* bits of the Flags field */

@@ -117,6 +117,26 @@ static int mps_step(void *data, mf_sim *sim, double dt)
 
 static void mps_destroy(void *data) { mps_destroy_data(data); }
 
+static void mps_report(void *data, const mf_sim *sim, mf_log *log)
+{
+    const mps_data *d = data;
+    const double steps = sim->step > 0 ? (double)sim->step : 1.0;
+    const double total = d->t_neighbours + d->t_explicit + d->t_assembly + d->t_solve +
+                         d->t_correction;
+    mf_log_printf(log, MF_LOG_QUIET,
+                  "MPS time per step (ms): neighbour search %.3f, explicit %.3f, number density "
+                  "+ assembly %.3f, pressure solve %.3f (AMG setup %.3f, PCG %.3f), correction "
+                  "%.3f; total %.3f\n",
+                  1e3 * d->t_neighbours / steps, 1e3 * d->t_explicit / steps,
+                  1e3 * d->t_assembly / steps, 1e3 * d->t_solve / steps,
+                  1e3 * d->t_setup / steps, 1e3 * d->t_pcg / steps,
+                  1e3 * d->t_correction / steps, 1e3 * total / steps);
+    mf_log_printf(log, MF_LOG_QUIET,
+                  "MPS pressure: %ld unknowns in the last solve, %.2f iterations per solve on "
+                  "average\n",
+                  d->ppe_rows, sim->pressure_iterations / steps);
+}
+
 const mf_solver_ops mf_solver_MPS = {
     .info = {MF_ABI_VERSION, MF_KIND_SOLVER, "MPS",
              "Moving Particle Semi-implicit method (the paper's Algorithm 1)", mps_params,
@@ -125,4 +145,5 @@ const mf_solver_ops mf_solver_MPS = {
     .step = mps_step,
     .destroy = mps_destroy,
     .stable_dt = NULL,
+    .report = mps_report,
 };

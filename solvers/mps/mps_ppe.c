@@ -159,6 +159,8 @@ int mps_solve_ppe(mps_data *d, mf_sim *sim)
                   d->pressure.info->name, d->last.initial_residual, d->last.final_residual,
                   d->last.iterations);
     sim->pressure_iterations += d->last.iterations;
+    d->t_setup += d->last.setup_seconds;
+    d->t_pcg += d->last.solve_seconds;
     d->t_solve += mf_wall_seconds() - t0;
     if (rc != 0)
         return mf_error_trace(rc, __FILE__, __LINE__, __func__);

@@ -141,6 +141,7 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
 /* eqs. 11-14 and 18: number density at r*, free surface, PPE. */
 int mps_pressure_phase(mps_data *d, mf_sim *sim, double dt)
 {
+    double t0 = mf_wall_seconds();
     mf_particles *p = sim->p;
     double *n = mf_particles_fd(p, d->f_number_density);
     int32_t *flags = mf_particles_fi(p, d->f_flags);
@@ -154,6 +155,7 @@ int mps_pressure_phase(mps_data *d, mf_sim *sim, double dt)
         if (!d->not_dummy[i])
             n[i] = 0; /* dummies take part only as neighbours */
     }
+    d->t_assembly += mf_wall_seconds() - t0;
     MF_CALL(mps_assemble_ppe(d, sim, dt));
     MF_CALL(mps_solve_ppe(d, sim));
     return 0;
