@@ -1,0 +1,474 @@
+/* grid.c: the occupied-cell grid (mf_neighbours.h); the lists are in nlist.c.
+ *
+ * Grid build, O(N) time, memory in particles and occupied cells:
+ *   1. bounding box -> origin and box size in cells;
+ *   2. each particle gets a compact sort key (ix | iy << bx | iz << (bx+by),
+ *      bx, by, bz the bits the box needs per axis): it orders cells like the
+ *      public 21-bit key but needs fewer radix passes;
+ *   3. stable LSD radix sort of (key, index) pairs;
+ *   4. distinct keys are the occupied cells; a hash table maps the public key
+ *      of a cell to its index;
+ *   5. for each cell, the 3^dim neighbouring cells form 3^(dim-1) rows along
+ *      x; the occupied cells of a row are consecutive in key order, so a row
+ *      is one range of sorted particles, stored per cell;
+ *   6. positions are copied in cell order (structure of arrays), so that the
+ *      list build streams through contiguous memory.
+ *
+ * The neighbour lists built on this grid are in nlist.c.
+ */
+#include "neighbours_internal.h"
+
+/* ---- grid: memory ----------------------------------------------------- */
+
+void mf_grid_init(mf_grid *g)
+{
+    memset(g, 0, sizeof *g);
+}
+
+void mf_grid_free(mf_grid *g)
+{
+    if (!g)
+        return;
+    free(g->cell_key);
+    free(g->cell_start);
+    free(g->cell_rows);
+    free(g->order);
+    free(g->hash_key);
+    free(g->hash_cell);
+    free(g->spos);
+    free(g->sort_key);
+    free(g->sort_idx);
+    mf_grid_init(g);
+}
+
+static void free_np_buffers(mf_grid *g)
+{
+    free(g->order);
+    free(g->spos);
+    free(g->sort_key);
+    free(g->sort_idx);
+    g->order = NULL;
+    g->spos = NULL;
+    g->sort_key = NULL;
+    g->sort_idx = NULL;
+    g->alloc_np = 0;
+}
+
+static int ensure_np_buffers(mf_grid *g, size_t np)
+{
+    if (g->order && !needs_realloc(g->alloc_np, np))
+        return 0;
+    size_t cap = with_headroom(np);
+    free_np_buffers(g);
+    if (cap > SIZE_MAX / 3 / sizeof(double))
+        return MF_ERROR(MF_ERR_MEMORY, "neighbour grid for %zu particles is too large", np);
+    int rc = 0;
+    if ((rc = replace_buffer((void **)&g->order, cap, sizeof(size_t), "particle order")) ||
+        (rc = replace_buffer((void **)&g->spos, 3 * cap, sizeof(double), "sorted positions")) ||
+        (rc = replace_buffer((void **)&g->sort_key, 2 * cap, sizeof(uint64_t), "sort keys")) ||
+        (rc = replace_buffer((void **)&g->sort_idx, 2 * cap, sizeof(uint32_t), "sort indices"))) {
+        free_np_buffers(g);
+        return mf_error_trace(rc, __FILE__, __LINE__, __func__);
+    }
+    g->alloc_np = cap;
+    return 0;
+}
+
+static void free_cell_buffers(mf_grid *g)
+{
+    free(g->cell_key);
+    free(g->cell_start);
+    free(g->cell_rows);
+    g->cell_key = NULL;
+    g->cell_start = NULL;
+    g->cell_rows = NULL;
+    g->alloc_cells = 0;
+}
+
+/* Rows are sized for 3-D so that a grid can switch dimension. */
+static int ensure_cell_buffers(mf_grid *g, size_t ncells)
+{
+    if (g->cell_start && !needs_realloc(g->alloc_cells, ncells))
+        return 0;
+    size_t cap = with_headroom(ncells);
+    free_cell_buffers(g);
+    if (cap > SIZE_MAX / (2 * MAX_ROWS * sizeof(uint32_t)))
+        return MF_ERROR(MF_ERR_MEMORY, "neighbour grid with %zu cells is too large", ncells);
+    int rc = 0;
+    if ((rc = replace_buffer((void **)&g->cell_key, cap, sizeof(uint64_t), "cell keys")) ||
+        (rc = replace_buffer((void **)&g->cell_start, cap + 1, sizeof(size_t), "cell starts")) ||
+        (rc = replace_buffer((void **)&g->cell_rows, 2 * MAX_ROWS * cap, sizeof(uint32_t),
+                             "cell rows"))) {
+        free_cell_buffers(g);
+        return mf_error_trace(rc, __FILE__, __LINE__, __func__);
+    }
+    g->alloc_cells = cap;
+    return 0;
+}
+
+/* Table of capacity a power of two >= 2 * ncells (load <= 1/2 keeps probe
+ * sequences short); reused unless more than 4 times too large. */
+static int ensure_hash(mf_grid *g, size_t ncells)
+{
+    size_t need = 16;
+    while (need < 2 * ncells) {
+        if (need > SIZE_MAX / 2)
+            return MF_ERROR(MF_ERR_MEMORY, "hash table for %zu cells is too large", ncells);
+        need *= 2;
+    }
+    if (!g->hash_key || g->hash_cap < need || g->hash_cap > 4 * need) {
+        int rc = 0;
+        g->hash_cap = 0;
+        if ((rc = replace_buffer((void **)&g->hash_key, need, sizeof(uint64_t), "hash keys")) ||
+            (rc = replace_buffer((void **)&g->hash_cell, need, sizeof(uint32_t), "hash cells"))) {
+            free(g->hash_key);
+            free(g->hash_cell);
+            g->hash_key = NULL;
+            g->hash_cell = NULL;
+            return mf_error_trace(rc, __FILE__, __LINE__, __func__);
+        }
+        g->hash_cap = need;
+    }
+    /* All bytes 0xFF gives UINT32_MAX, the empty mark. */
+    memset(g->hash_cell, 0xFF, g->hash_cap * sizeof(uint32_t));
+    return 0;
+}
+
+size_t mf_grid_memory(const mf_grid *g)
+{
+    if (!g)
+        return 0;
+    size_t per_particle = sizeof(size_t) + 3 * sizeof(double) + 2 * sizeof(uint64_t) +
+                          2 * sizeof(uint32_t);
+    size_t per_cell = sizeof(uint64_t) + sizeof(size_t) + 2 * MAX_ROWS * sizeof(uint32_t);
+    size_t bytes = g->alloc_np * per_particle;
+    if (g->cell_start)
+        bytes += g->alloc_cells * per_cell + sizeof(size_t);
+    bytes += g->hash_cap * (sizeof(uint64_t) + sizeof(uint32_t));
+    return bytes;
+}
+
+/* ---- grid: cells and hash table ------------------------------------------ */
+
+static void hash_insert(mf_grid *g, uint64_t key, uint32_t cell)
+{
+    size_t mask = g->hash_cap - 1;
+    size_t h = (size_t)mix64(key) & mask;
+    while (g->hash_cell[h] != EMPTY_SLOT)
+        h = (h + 1) & mask;
+    g->hash_key[h] = key;
+    g->hash_cell[h] = cell;
+}
+
+long mf_grid_find_cell(const mf_grid *g, uint64_t key)
+{
+    if (!g || g->ncells == 0)
+        return -1;
+    size_t mask = g->hash_cap - 1;
+    size_t h = (size_t)mix64(key) & mask;
+    while (g->hash_cell[h] != EMPTY_SLOT) {
+        if (g->hash_key[h] == key)
+            return (long)g->hash_cell[h];
+        h = (h + 1) & mask;
+    }
+    return -1;
+}
+
+/* Integer cell coordinate of x on one axis; the same expression is used
+ * everywhere so that a point always lands in the same cell. */
+static inline uint64_t cell_coord(double x, double origin, double inv_width)
+{
+    return (uint64_t)floor((x - origin) * inv_width);
+}
+
+long mf_grid_point_cell(const mf_grid *g, const double x[3])
+{
+    if (!g || g->ncells == 0 || !x)
+        return -1;
+    double inv_width = 1.0 / binning_width(g->cell_size);
+    uint64_t c[3] = {0, 0, 0};
+    for (int d = 0; d < g->dim; d++) {
+        double u = (x[d] - g->origin[d]) * inv_width;
+        if (!(u >= 0.0) || u >= (double)g->nbox[d])
+            return -1;
+        c[d] = cell_coord(x[d], g->origin[d], inv_width);
+        if (c[d] >= g->nbox[d])
+            return -1;
+    }
+    return mf_grid_find_cell(g, mf_grid_key(c[0], c[1], c[2]));
+}
+
+/* The rows of cells around cell c as ranges [a, b) of sorted particles,
+ * into rows[2 * r], rows[2 * r + 1] (a == b for an empty row). */
+static void find_rows(const mf_grid *g, size_t c, uint32_t *rows)
+{
+    const uint64_t key = g->cell_key[c];
+    const uint64_t ix = key & AXIS_MASK;
+    const uint64_t iy = (key >> MF_GRID_AXIS_BITS) & AXIS_MASK;
+    const uint64_t iz = key >> (2 * MF_GRID_AXIS_BITS);
+    const uint64_t x0 = ix > 0 ? ix - 1 : 0;
+    const uint64_t x1 = ix + 1 < g->nbox[0] ? ix + 1 : ix;
+    int r = 0;
+    for (int dz = -1; dz <= 1; dz++) {
+        if (g->dim == 2 && dz != 0)
+            continue;
+        for (int dy = -1; dy <= 1; dy++, r++) {
+            rows[2 * r] = rows[2 * r + 1] = 0;
+            if ((dz < 0 && iz == 0) || (dz > 0 && iz + 1 >= g->nbox[2]) || (dy < 0 && iy == 0) ||
+                (dy > 0 && iy + 1 >= g->nbox[1]))
+                continue;
+            const uint64_t y = iy + (uint64_t)(int64_t)dy, z = iz + (uint64_t)(int64_t)dz;
+            long first = -1, last = -1;
+            const uint64_t mid_key = mf_grid_key(ix, y, z);
+            long mid = dy == 0 && dz == 0 ? (long)c : mf_grid_find_cell(g, mid_key);
+            if (mid >= 0) {
+                /* Cells are sorted by key: the x-neighbours of an occupied
+                 * cell, if occupied, are the cells next to it. */
+                first = last = mid;
+                if (x0 < ix && mid > 0 && g->cell_key[mid - 1] == mid_key - 1)
+                    first = mid - 1;
+                if (x1 > ix && (size_t)mid + 1 < g->ncells && g->cell_key[mid + 1] == mid_key + 1)
+                    last = mid + 1;
+            } else {
+                for (uint64_t x = x0; x <= x1; x++) {
+                    long cell = x == ix ? -1 : mf_grid_find_cell(g, mf_grid_key(x, y, z));
+                    if (cell >= 0) {
+                        if (first < 0)
+                            first = cell;
+                        last = cell;
+                    }
+                }
+            }
+            if (first >= 0) {
+                rows[2 * r] = (uint32_t)g->cell_start[first];
+                rows[2 * r + 1] = (uint32_t)g->cell_start[last + 1];
+            }
+        }
+    }
+}
+
+/* ---- grid: build -------------------------------------------------------- */
+
+/* Leave a failed build as a valid empty grid. */
+static void make_empty(mf_grid *g)
+{
+    g->np = 0;
+    g->ncells = 0;
+    if (g->cell_start)
+        g->cell_start[0] = 0;
+    if (g->hash_cell)
+        memset(g->hash_cell, 0xFF, g->hash_cap * sizeof(uint32_t));
+}
+
+/* Bounding box of the first n particles; fails on a non-finite coordinate
+ * (it would poison the cell coordinates). */
+static int bounding_box(const mf_particles *p, size_t n, double lo[3], double hi[3])
+{
+    const double *pos = p->pos;
+    const int dim = p->dim;
+    double x0 = INFINITY, y0 = INFINITY, z0 = INFINITY;
+    double x1 = -INFINITY, y1 = -INFINITY, z1 = -INFINITY;
+    size_t bad = 0;
+#pragma omp parallel for schedule(static) reduction(min : x0, y0, z0) \
+    reduction(max : x1, y1, z1) reduction(+ : bad)
+    for (size_t i = 0; i < n; i++) {
+        const double *x = pos + 3 * i;
+        double z = dim == 3 ? x[2] : 0.0;
+        if (!isfinite(x[0]) || !isfinite(x[1]) || !isfinite(z))
+            bad++;
+        /* Not fmin/fmax: those are library calls at -O2. */
+        x0 = x[0] < x0 ? x[0] : x0;
+        x1 = x[0] > x1 ? x[0] : x1;
+        y0 = x[1] < y0 ? x[1] : y0;
+        y1 = x[1] > y1 ? x[1] : y1;
+        z0 = z < z0 ? z : z0;
+        z1 = z > z1 ? z : z1;
+    }
+    if (bad) {
+        for (size_t i = 0; i < n; i++) {
+            const double *x = pos + 3 * i;
+            if (!isfinite(x[0]) || !isfinite(x[1]) || (dim == 3 && !isfinite(x[2])))
+                return MF_ERROR(MF_ERR_NUMERIC,
+                                "particle %zu has a non-finite position (%g, %g, %g); %zu such",
+                                i, x[0], x[1], x[2], bad);
+        }
+    }
+    lo[0] = x0, lo[1] = y0, lo[2] = z0;
+    hi[0] = x1, hi[1] = y1, hi[2] = z1;
+    return 0;
+}
+
+/* Stable LSD radix sort of (key, idx) on the low `bits` bits of key.
+ * key/idx hold 2 * n entries: the input in the first half; returns the half
+ * (0 or 1) holding the sorted output. Passes are balanced so that a 14-bit
+ * key takes two 7-bit passes and not an 11-bit and a 3-bit one. */
+static int radix_sort(uint64_t *key, uint32_t *idx, size_t n, int bits)
+{
+    if (bits == 0 || n < 2)
+        return 0;
+    int passes = (bits + RADIX_BITS - 1) / RADIX_BITS;
+    int digit_bits = (bits + passes - 1) / passes;
+    uint64_t digit_mask = ((uint64_t)1 << digit_bits) - 1;
+    size_t count[RADIX_SIZE];
+    int src = 0;
+    for (int pass = 0; pass < passes; pass++) {
+        int shift = pass * digit_bits;
+        const uint64_t *ks = key + src * n;
+        const uint32_t *is = idx + src * n;
+        uint64_t *kd = key + (1 - src) * n;
+        uint32_t *id = idx + (1 - src) * n;
+        memset(count, 0, sizeof count);
+        for (size_t i = 0; i < n; i++)
+            count[(ks[i] >> shift) & digit_mask]++;
+        size_t sum = 0;
+        for (size_t d = 0; d <= digit_mask; d++) {
+            size_t c = count[d];
+            count[d] = sum;
+            sum += c;
+        }
+        for (size_t i = 0; i < n; i++) {
+            size_t dst = count[(ks[i] >> shift) & digit_mask]++;
+            kd[dst] = ks[i];
+            id[dst] = is[i];
+        }
+        src = 1 - src;
+    }
+    return src;
+}
+
+int mf_grid_build(mf_grid *g, const mf_particles *p, double cell_size)
+{
+    if (!g || !p)
+        return MF_ERROR(MF_ERR_INPUT, "mf_grid_build: NULL grid or particles");
+    if (!(cell_size > 0.0) || !isfinite(cell_size))
+        return MF_ERROR(MF_ERR_INPUT, "neighbour cell size must be positive and finite, got %g",
+                        cell_size);
+    if (p->dim != 2 && p->dim != 3)
+        return MF_ERROR(MF_ERR_INPUT, "particle dimension must be 2 or 3, got %d", p->dim);
+    const size_t np = p->n;
+    if (np >= UINT32_MAX)
+        return MF_ERROR(MF_ERR_INPUT,
+                        "%zu particles on one rank: neighbour indices are 32-bit (limit %u)", np,
+                        UINT32_MAX - 1);
+    const int dim = p->dim;
+    g->dim = dim;
+    g->cell_size = cell_size;
+    make_empty(g);
+
+    int rc = 0;
+    double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    if (np > 0)
+        MF_CALL_GOTO(rc, bounding_box(p, np, lo, hi), fail);
+
+    /* The margin keeps the lowest particles off the origin face, so they do
+     * not depend on how x - origin rounds. */
+    const double inv_width = 1.0 / binning_width(cell_size);
+    const double margin = 1e-3 * cell_size;
+    int axis_bits[3] = {0, 0, 0};
+    for (int d = 0; d < 3; d++) {
+        g->origin[d] = d < dim ? lo[d] - margin : 0.0;
+        g->nbox[d] = 1;
+        if (d >= dim || np == 0)
+            continue;
+        double span = (hi[d] - g->origin[d]) * inv_width;
+        if (!(span < (double)(AXIS_LIMIT - 1)))
+            MF_CALL_GOTO(rc,
+                         MF_ERROR(MF_ERR_INPUT,
+                                  "particles span %g on axis %c, more than 2^%d cells of size %g: "
+                                  "the spacing is too small for the domain extent (or a particle "
+                                  "has escaped)",
+                                  hi[d] - lo[d], "xyz"[d], MF_GRID_AXIS_BITS, cell_size),
+                         fail);
+        g->nbox[d] = cell_coord(hi[d], g->origin[d], inv_width) + 1;
+        axis_bits[d] = bits_for(g->nbox[d]);
+    }
+
+    MF_CALL_GOTO(rc, ensure_np_buffers(g, np > 0 ? np : 1), fail);
+
+    /* Compact sort keys: same order as the public key, fewer bits. */
+    {
+        const double *pos = p->pos;
+        const double o0 = g->origin[0], o1 = g->origin[1], o2 = g->origin[2];
+        const int sy = axis_bits[0], sz = axis_bits[0] + axis_bits[1];
+        uint64_t *key = g->sort_key;
+        uint32_t *idx = g->sort_idx;
+#pragma omp parallel for schedule(static)
+        for (size_t i = 0; i < np; i++) {
+            const double *x = pos + 3 * i;
+            uint64_t k = cell_coord(x[0], o0, inv_width) | cell_coord(x[1], o1, inv_width) << sy;
+            if (dim == 3)
+                k |= cell_coord(x[2], o2, inv_width) << sz;
+            key[i] = k;
+            idx[i] = (uint32_t)i;
+        }
+    }
+    const int total_bits = axis_bits[0] + axis_bits[1] + axis_bits[2];
+    const int half = radix_sort(g->sort_key, g->sort_idx, np, total_bits);
+    const uint64_t *skey = g->sort_key + half * np;
+    const uint32_t *sidx = g->sort_idx + half * np;
+
+    size_t ncells = np > 0 ? 1 : 0;
+    for (size_t k = 1; k < np; k++)
+        ncells += skey[k] != skey[k - 1];
+    MF_CALL_GOTO(rc, ensure_cell_buffers(g, ncells), fail);
+    MF_CALL_GOTO(rc, ensure_hash(g, ncells), fail);
+
+    /* Cells: starts and public keys. */
+    {
+        const uint64_t mx = ((uint64_t)1 << axis_bits[0]) - 1;
+        const uint64_t my = ((uint64_t)1 << axis_bits[1]) - 1;
+        const int sy = axis_bits[0], sz = axis_bits[0] + axis_bits[1];
+        size_t c = 0;
+        for (size_t k = 0; k < np; k++) {
+            if (k == 0 || skey[k] != skey[k - 1]) {
+                uint64_t s = skey[k];
+                g->cell_key[c] = mf_grid_key(s & mx, (s >> sy) & my, s >> sz);
+                g->cell_start[c] = k;
+                c++;
+            }
+        }
+        g->cell_start[ncells] = np;
+    }
+    g->ncells = ncells;
+    for (size_t c = 0; c < ncells; c++)
+        hash_insert(g, g->cell_key[c], (uint32_t)c);
+
+    /* Rows of neighbouring cells, once per cell for all later list builds. */
+    {
+        const int stride = 2 * rows_per_cell(dim);
+#pragma omp parallel for schedule(static)
+        for (size_t c = 0; c < ncells; c++)
+            find_rows(g, c, g->cell_rows + c * stride);
+    }
+
+    /* Order and positions in cell order. */
+    {
+        const double *pos = p->pos;
+        size_t *order = g->order;
+        double *sx = g->spos, *sy = g->spos + np, *sz = g->spos + 2 * np;
+#pragma omp parallel for schedule(static)
+        for (size_t k = 0; k < np; k++) {
+            size_t i = sidx[k];
+            order[k] = i;
+            sx[k] = pos[3 * i];
+            sy[k] = pos[3 * i + 1];
+            sz[k] = dim == 3 ? pos[3 * i + 2] : 0.0;
+        }
+    }
+    g->np = np;
+    return 0;
+
+fail:
+    make_empty(g);
+    return rc;
+}
+
+int mf_grid_locality_order(const mf_grid *g, size_t *perm)
+{
+    if (!g || (!perm && g->np > 0))
+        return MF_ERROR(MF_ERR_INPUT, "mf_grid_locality_order: NULL grid or output");
+    if (g->np > 0)
+        memcpy(perm, g->order, g->np * sizeof *perm);
+    return 0;
+}
+

@@ -1,0 +1,455 @@
+/* nlist.c: CSR neighbour lists over the occupied-cell grid of grid.c
+ * (mf_neighbours.h). How the grid is built is described in grid.c.
+ *
+ * List build, two parallel passes over cells:
+ *   count: test every candidate of every particle, store the outcome as one
+ *          bit per candidate and the count per particle;
+ *   fill:  after a prefix sum of the counts, turn the set bits into indices.
+ * The distance test thus runs once per candidate, and both passes read the
+ * same bits, so they cannot disagree. The j's of a particle come in row and
+ * cell order, the same for any thread count. When the bits would take too
+ * much memory (cells much larger than the radius) the fill pass repeats the
+ * distance test instead.
+ */
+#include "neighbours_internal.h"
+
+/* ---- neighbour lists: memory ---------------------------------------------- */
+
+void mf_nlist_init(mf_nlist *nl)
+{
+    memset(nl, 0, sizeof *nl);
+}
+
+void mf_nlist_free(mf_nlist *nl)
+{
+    if (!nl)
+        return;
+    free(nl->start);
+    free(nl->j);
+    free(nl->work);
+    mf_nlist_init(nl);
+}
+
+size_t mf_nlist_memory(const mf_nlist *nl)
+{
+    if (!nl)
+        return 0;
+    return nl->cap_n * sizeof(size_t) + nl->cap_j * sizeof(uint32_t) + nl->work_bytes;
+}
+
+static int ensure_start(mf_nlist *nl, size_t n)
+{
+    if (nl->start && !needs_realloc(nl->cap_n, n + 1))
+        return 0;
+    nl->cap_n = 0;
+    size_t cap = with_headroom(n + 1);
+    MF_CALL(replace_buffer((void **)&nl->start, cap, sizeof(size_t), "list starts"));
+    nl->cap_n = cap;
+    return 0;
+}
+
+static int ensure_entries(mf_nlist *nl, size_t count)
+{
+    if (nl->j && !needs_realloc(nl->cap_j, count))
+        return 0;
+    nl->cap_j = 0;
+    size_t cap = with_headroom(count);
+    MF_CALL(replace_buffer((void **)&nl->j, cap, sizeof(uint32_t), "list entries"));
+    nl->cap_j = cap;
+    return 0;
+}
+
+/* Scratch of at least `bytes`, 8-byte aligned (malloc's alignment). */
+static int ensure_work(mf_nlist *nl, size_t bytes)
+{
+    if (nl->work && !needs_realloc(nl->work_bytes, bytes))
+        return 0;
+    nl->work_bytes = 0;
+    size_t cap = with_headroom(bytes);
+    MF_CALL(replace_buffer(&nl->work, cap, 1, "list scratch"));
+    nl->work_bytes = cap;
+    return 0;
+}
+
+/* start[i + 1] holds the count of i on entry; start becomes offsets. */
+static void counts_to_offsets(size_t *start, size_t n)
+{
+    start[0] = 0;
+    for (size_t i = 0; i < n; i++)
+        start[i + 1] += start[i];
+}
+
+/* ---- neighbour lists: the distance test ---------------------------------- */
+
+/* Two candidates at a time. GCC/clang vector extensions give SIMD at -O2 (the
+ * cheap cost model does not vectorize these short loops by itself); 16-byte
+ * vectors are in the x86-64 and AArch64 baselines. Each lane computes
+ * exactly the scalar expression (dx*dx + dy*dy) + dz*dz, so results equal a
+ * scalar loop's (and a brute-force check's). */
+typedef double vec2d __attribute__((vector_size(2 * sizeof(double))));
+typedef int64_t vec2i __attribute__((vector_size(2 * sizeof(int64_t))));
+
+typedef struct {
+    const double *sx, *sy, *sz; /* positions in cell order */
+    double r2;
+} pair_test;
+
+static inline vec2d load2(const double *x)
+{
+    vec2d v;
+    memcpy(&v, x, sizeof v);
+    return v;
+}
+
+static inline vec2d splat2(double x)
+{
+    return (vec2d){x, x};
+}
+
+/* Candidates m, m + 1 closer than the radius: lanes -1 (in) or 0 (out). */
+KERNEL vec2i within2(const pair_test *t, size_t m, const double xi[3], int dim)
+{
+    vec2d dx = load2(t->sx + m) - splat2(xi[0]);
+    vec2d dy = load2(t->sy + m) - splat2(xi[1]);
+    vec2d d2 = dx * dx + dy * dy;
+    if (dim == 3) {
+        vec2d dz = load2(t->sz + m) - splat2(xi[2]);
+        d2 += dz * dz;
+    }
+    return d2 < splat2(t->r2);
+}
+
+/* The two lanes of a test as bits 0 and 1. */
+static inline unsigned lane_bits(vec2i h)
+{
+#if defined(__SSE2__)
+    return (unsigned)_mm_movemask_pd((__m128d)h); /* one instruction */
+#else
+    return (unsigned)((h[0] & 1) | (h[1] & 2));
+#endif
+}
+
+KERNEL bool within1(const pair_test *t, size_t m, const double xi[3], int dim)
+{
+    double dx = t->sx[m] - xi[0], dy = t->sy[m] - xi[1];
+    double d2 = dx * dx + dy * dy;
+    if (dim == 3) {
+        double dz = t->sz[m] - xi[2];
+        d2 += dz * dz;
+    }
+    return d2 < t->r2;
+}
+
+/* Candidate bits: a particle's bits start at a word, and each row at an even
+ * bit (the tests come in pairs). row_bit[r] is the first bit of row r,
+ * row_bit[nrows] the total. */
+static void row_bit_offsets(const uint32_t *rows, int nrows, size_t row_bit[MAX_ROWS + 1])
+{
+    row_bit[0] = 0;
+    for (int r = 0; r < nrows; r++)
+        row_bit[r + 1] = row_bit[r] + (((size_t)(rows[2 * r + 1] - rows[2 * r]) + 1) & ~(size_t)1);
+}
+
+static size_t words_per_particle(const uint32_t *rows, int nrows)
+{
+    size_t row_bit[MAX_ROWS + 1];
+    row_bit_offsets(rows, nrows, row_bit);
+    return (row_bit[nrows] + 63) / 64;
+}
+
+/* Test every candidate of sorted particle k (position xi); with keep_bits,
+ * store the outcomes as bits in words. Returns the count of hits, the
+ * particle itself included (its distance 0 is < r2). dim and keep_bits are
+ * literals at the call sites, so each combination compiles to its own loop. */
+KERNEL size_t test_candidates(const pair_test *t, const uint32_t *rows, int nrows,
+                              const double xi[3], int dim, bool keep_bits, uint64_t *words)
+{
+    vec2i hits = {0, 0};
+    uint64_t acc = 0;
+    unsigned bit = 0;
+    for (int r = 0; r < nrows; r++) {
+        size_t m = rows[2 * r];
+        const size_t b = rows[2 * r + 1];
+        for (; m + 2 <= b; m += 2) {
+            vec2i h = within2(t, m, xi, dim);
+            hits -= h;
+            if (keep_bits) {
+                acc |= (uint64_t)lane_bits(h) << bit;
+                bit += 2;
+                if (bit == 64) {
+                    *words++ = acc;
+                    acc = 0;
+                    bit = 0;
+                }
+            }
+        }
+        if (m < b) {
+            uint64_t h = within1(t, m, xi, dim);
+            hits[0] += (int64_t)h;
+            if (keep_bits) {
+                acc |= h << bit;
+                bit += 2;
+                if (bit == 64) {
+                    *words++ = acc;
+                    acc = 0;
+                    bit = 0;
+                }
+            }
+        }
+    }
+    if (keep_bits && bit)
+        *words = acc;
+    return (size_t)(hits[0] + hits[1]);
+}
+
+/* Append the particle indices of the set bits (other than k itself). */
+KERNEL size_t decode_bits(const uint64_t *words, size_t nwords, const uint32_t *rows,
+                          const size_t row_bit[MAX_ROWS + 1], const size_t *order, size_t k,
+                          uint32_t *out)
+{
+    size_t w = 0;
+    int r = 0;
+    for (size_t wi = 0; wi < nwords; wi++) {
+        uint64_t word = words[wi];
+        while (word) {
+            size_t bit = 64 * wi + (size_t)__builtin_ctzll(word);
+            word &= word - 1;
+            while (bit >= row_bit[r + 1])
+                r++;
+            size_t m = rows[2 * r] + (bit - row_bit[r]);
+            if (m != k)
+                out[w++] = (uint32_t)order[m];
+        }
+    }
+    return w;
+}
+
+/* Fallback fill without bits: repeat the distance test. */
+KERNEL size_t retest_candidates(const pair_test *t, const uint32_t *rows, int nrows,
+                                const size_t *order, size_t k, const double xi[3], int dim,
+                                uint32_t *out)
+{
+    size_t w = 0;
+    for (int r = 0; r < nrows; r++) {
+        size_t m = rows[2 * r];
+        const size_t b = rows[2 * r + 1];
+        for (; m + 2 <= b; m += 2) {
+            vec2i h = within2(t, m, xi, dim);
+            if (h[0] && m != k)
+                out[w++] = (uint32_t)order[m];
+            if (h[1] && m + 1 != k)
+                out[w++] = (uint32_t)order[m + 1];
+        }
+        if (m < b && within1(t, m, xi, dim) && m != k)
+            out[w++] = (uint32_t)order[m];
+    }
+    return w;
+}
+
+/* ---- neighbour lists: the two passes -------------------------------------- */
+
+typedef struct {
+    const mf_grid *g;
+    pair_test t;
+    int nrows;
+    const size_t *cell_word; /* ncells + 1 word offsets, or NULL: no bits */
+    uint64_t *bits;
+} list_build;
+
+/* Pass 1: start[i + 1] = number of neighbours of i; bits if kept. */
+KERNEL void count_cell(const list_build *lb, size_t c, int dim, bool keep_bits, size_t *start)
+{
+    const mf_grid *g = lb->g;
+    const uint32_t *rows = g->cell_rows + (size_t)c * 2 * lb->nrows;
+    const size_t k0 = g->cell_start[c], k1 = g->cell_start[c + 1];
+    uint64_t *words = NULL;
+    size_t nwords = 0;
+    if (keep_bits) {
+        words = lb->bits + lb->cell_word[c];
+        nwords = (lb->cell_word[c + 1] - lb->cell_word[c]) / (k1 - k0);
+    }
+    for (size_t k = k0; k < k1; k++) {
+        const double xi[3] = {lb->t.sx[k], lb->t.sy[k], lb->t.sz[k]};
+        size_t hits = test_candidates(&lb->t, rows, lb->nrows, xi, dim, keep_bits,
+                                      keep_bits ? words + (k - k0) * nwords : NULL);
+        start[g->order[k] + 1] = hits - 1; /* minus the particle itself */
+    }
+}
+
+static void count_pass(const list_build *lb, size_t *start)
+{
+    const size_t ncells = lb->g->ncells;
+    const int dim = lb->g->dim;
+    const bool keep_bits = lb->cell_word != NULL;
+#pragma omp parallel for schedule(dynamic, 32)
+    for (size_t c = 0; c < ncells; c++) {
+        /* Literals let the compiler specialise the kernels. */
+        if (dim == 3 && keep_bits)
+            count_cell(lb, c, 3, true, start);
+        else if (dim == 3)
+            count_cell(lb, c, 3, false, start);
+        else if (keep_bits)
+            count_cell(lb, c, 2, true, start);
+        else
+            count_cell(lb, c, 2, false, start);
+    }
+}
+
+/* Pass 2: j's at the offsets of pass 1, from the bits or by testing again. */
+KERNEL void fill_cell(const list_build *lb, size_t c, int dim, const size_t *start,
+                      uint32_t *jlist)
+{
+    const mf_grid *g = lb->g;
+    const uint32_t *rows = g->cell_rows + (size_t)c * 2 * lb->nrows;
+    const size_t k0 = g->cell_start[c], k1 = g->cell_start[c + 1];
+    size_t row_bit[MAX_ROWS + 1], nwords = 0;
+    if (lb->cell_word) {
+        row_bit_offsets(rows, lb->nrows, row_bit);
+        nwords = (lb->cell_word[c + 1] - lb->cell_word[c]) / (k1 - k0);
+    }
+    for (size_t k = k0; k < k1; k++) {
+        uint32_t *out = jlist + start[g->order[k]];
+        if (lb->cell_word) {
+            const uint64_t *words = lb->bits + lb->cell_word[c] + (k - k0) * nwords;
+            decode_bits(words, nwords, rows, row_bit, g->order, k, out);
+        } else {
+            const double xi[3] = {lb->t.sx[k], lb->t.sy[k], lb->t.sz[k]};
+            retest_candidates(&lb->t, rows, lb->nrows, g->order, k, xi, dim, out);
+        }
+    }
+}
+
+static void fill_pass(const list_build *lb, const size_t *start, uint32_t *jlist)
+{
+    const size_t ncells = lb->g->ncells;
+    const int dim = lb->g->dim;
+#pragma omp parallel for schedule(dynamic, 32)
+    for (size_t c = 0; c < ncells; c++) {
+        if (dim == 3)
+            fill_cell(lb, c, 3, start, jlist);
+        else
+            fill_cell(lb, c, 2, start, jlist);
+    }
+}
+
+/* Lay out the candidate bits: word offsets per cell at the start of the
+ * scratch, the bits after them. Leaves lb->cell_word NULL (no bits) when
+ * they would exceed MAX_BIT_WORDS_PER_PARTICLE on average. */
+static int plan_bits(mf_nlist *nl, list_build *lb)
+{
+    const mf_grid *g = lb->g;
+    const size_t ncells = g->ncells;
+    size_t total = 0;
+    for (size_t c = 0; c < ncells; c++) {
+        const uint32_t *rows = g->cell_rows + c * 2 * lb->nrows;
+        total += words_per_particle(rows, lb->nrows) * (g->cell_start[c + 1] - g->cell_start[c]);
+    }
+    lb->cell_word = NULL;
+    lb->bits = NULL;
+    if (total > MAX_BIT_WORDS_PER_PARTICLE * g->np)
+        return 0;
+    MF_CALL(ensure_work(nl, (ncells + 1 + total) * sizeof(uint64_t)));
+    size_t *cell_word = nl->work;
+    size_t offset = 0;
+    for (size_t c = 0; c < ncells; c++) {
+        const uint32_t *rows = g->cell_rows + c * 2 * lb->nrows;
+        cell_word[c] = offset;
+        offset += words_per_particle(rows, lb->nrows) * (g->cell_start[c + 1] - g->cell_start[c]);
+    }
+    cell_word[ncells] = offset;
+    lb->cell_word = cell_word;
+    lb->bits = (uint64_t *)nl->work + (ncells + 1);
+    return 0;
+}
+
+int mf_nlist_build(mf_nlist *nl, const mf_grid *g, const mf_particles *p, double radius)
+{
+    if (!nl || !g || !p)
+        return MF_ERROR(MF_ERR_INPUT, "mf_nlist_build: NULL list, grid or particles");
+    if (!(radius * radius > 0.0) || radius > g->cell_size)
+        return MF_ERROR(MF_ERR_INPUT,
+                        "neighbour radius %g must be positive and at most the cell size %g",
+                        radius, g->cell_size);
+    if (g->np != p->n || g->dim != p->dim)
+        return MF_ERROR(MF_ERR_INPUT,
+                        "grid is stale: built for %zu particles in %d-D, now %zu in %d-D "
+                        "(call mf_grid_build first)",
+                        g->np, g->dim, p->n, p->dim);
+    const size_t n = g->np;
+    MF_CALL(ensure_start(nl, n));
+    nl->n = 0;
+    nl->radius = radius;
+
+    list_build lb = {
+        .g = g,
+        .t = {g->spos, g->spos + n, g->spos + 2 * n, radius * radius},
+        .nrows = rows_per_cell(g->dim),
+    };
+    MF_CALL(plan_bits(nl, &lb));
+    count_pass(&lb, nl->start);
+    counts_to_offsets(nl->start, n);
+    MF_CALL(ensure_entries(nl, nl->start[n] > 0 ? nl->start[n] : 1));
+    fill_pass(&lb, nl->start, nl->j);
+    nl->n = n;
+    return 0;
+}
+
+/* ---- filtering ------------------------------------------------------------ */
+
+/* Squared distance of particles i and j, computed as in the list build. */
+static inline double distance2(const double *pos, int dim, size_t i, size_t j)
+{
+    const double *a = pos + 3 * i, *b = pos + 3 * j;
+    double dx = b[0] - a[0], dy = b[1] - a[1];
+    double d2 = dx * dx + dy * dy;
+    if (dim == 3) {
+        double dz = b[2] - a[2];
+        d2 += dz * dz;
+    }
+    return d2;
+}
+
+int mf_nlist_filter(mf_nlist *nl, const mf_nlist *from, const mf_particles *p, double radius)
+{
+    if (!nl || !from || !p)
+        return MF_ERROR(MF_ERR_INPUT, "mf_nlist_filter: NULL list or particles");
+    if (nl == from)
+        return MF_ERROR(MF_ERR_INPUT, "mf_nlist_filter: output and input lists must differ");
+    if (!(radius * radius > 0.0) || radius > from->radius)
+        return MF_ERROR(MF_ERR_INPUT,
+                        "filter radius %g must be positive and at most the list radius %g",
+                        radius, from->radius);
+    if (from->n != p->n)
+        return MF_ERROR(MF_ERR_INPUT, "neighbour list covers %zu particles, the store holds %zu",
+                        from->n, p->n);
+    const size_t n = from->n;
+    MF_CALL(ensure_start(nl, n));
+    nl->n = 0;
+    nl->radius = radius;
+    const double r2 = radius * radius;
+    const double *pos = p->pos;
+    const int dim = p->dim;
+    size_t *start = nl->start;
+
+#pragma omp parallel for schedule(dynamic, 256)
+    for (size_t i = 0; i < n; i++) {
+        size_t count = 0;
+        for (size_t e = from->start[i]; e < from->start[i + 1]; e++)
+            count += distance2(pos, dim, i, from->j[e]) < r2;
+        start[i + 1] = count;
+    }
+    counts_to_offsets(start, n);
+    MF_CALL(ensure_entries(nl, start[n] > 0 ? start[n] : 1));
+    uint32_t *jlist = nl->j;
+#pragma omp parallel for schedule(dynamic, 256)
+    for (size_t i = 0; i < n; i++) {
+        uint32_t *out = jlist + start[i];
+        for (size_t e = from->start[i]; e < from->start[i + 1]; e++)
+            /* Testing again is as fast as keeping a byte per entry of `from`,
+             * and needs no memory. */
+            if (distance2(pos, dim, i, from->j[e]) < r2)
+                *out++ = from->j[e];
+    }
+    nl->n = n;
+    return 0;
+}
