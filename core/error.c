@@ -24,10 +24,14 @@ static void push_frame(const char *file, int line, const char *func)
 
 int mf_error_raise(int code, const char *file, int line, const char *func, const char *fmt, ...)
 {
+    /* Format aside first: callers may pass mf_error_message() itself to wrap
+     * an earlier failure in context. */
+    char message[sizeof trace.message];
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(trace.message, sizeof trace.message, fmt, ap);
+    vsnprintf(message, sizeof message, fmt, ap);
     va_end(ap);
+    memcpy(trace.message, message, sizeof message);
     trace.code = code;
     trace.depth = 0;
     push_frame(file, line, func);

@@ -30,6 +30,10 @@ int mf_scene_read_fluids(const mf_dict *fluids, mf_sim *sim);
  * `resolved` (may be NULL) receives the geometry as used. */
 int mf_scene_build(const mf_dict *geometry, double l0_override, mf_sim *sim, mf_dict *resolved);
 
+/* Refuse particles closer than l0/2 (overlapping blocks, a block inside a
+ * wall), naming the first pair. */
+int mf_scene_check_overlap(const mf_sim *sim);
+
 /* Index of a fluid by name, or an error listing the fluids. */
 int mf_scene_fluid_index(const mf_sim *sim, const char *name, int *index);
 

@@ -203,6 +203,7 @@ int mf_app_setup(mf_app *app)
     mf_dict *resolved = app->cs.resolved;
     MF_CALL(mf_scene_build(app->cs.geometry, app->opt.l0, sim,
                            mf_dict_set_subdict(resolved, "geometry")));
+    MF_CALL(mf_scene_check_overlap(sim));
     mf_dict *rf = mf_dict_set_subdict(resolved, "fluids");
     for (int k = 0; k < sim->nfluids; k++) {
         mf_dict *f = mf_dict_set_subdict(rf, sim->fluid[k].name);
