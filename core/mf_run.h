@@ -36,7 +36,6 @@ typedef struct mf_run {
     mf_module *functions;            /* function objects */
     const mf_dict *params;           /* resolved case, handed to the writer */
     /* Filled by the loop. */
-    double natural_dt;  /* last step the limits allowed, before landing on a write time */
     long steps, retries;
     double wall_seconds;
     int writes;

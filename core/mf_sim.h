@@ -41,6 +41,9 @@ typedef struct mf_sim {
     double time;
     double end_time;
     double dt;                 /* the step being taken (or last taken) */
+    double dt_natural;         /* the last step the limits allowed, before it was shortened
+                                  to land on a write time: the controller grows from it, so
+                                  a restart needs it to continue exactly */
     long step;
     /* Time-step control (system/controlDict). */
     double max_courant;

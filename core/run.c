@@ -173,7 +173,7 @@ static int choose_dt(mf_run *run, double next_write, double *dt, const char **li
         double natural = ch.dt;
         *limiter = ch.limiter;
         /* Start at deltaT, grow at most 20% a step (OpenFOAM's damping). */
-        double last = run->natural_dt > 0 ? run->natural_dt : c->delta_t;
+        double last = run->sim->dt_natural > 0 ? run->sim->dt_natural : c->delta_t;
         if (natural > 1.2 * last) {
             natural = 1.2 * last;
             *limiter = "growth";
@@ -186,7 +186,7 @@ static int choose_dt(mf_run *run, double next_write, double *dt, const char **li
                 *limiter = "solver";
             }
         }
-        run->natural_dt = natural;
+        run->sim->dt_natural = natural;
         *dt = natural;
         /* Land on write times and the end time (adjustableRunTime). */
         double target = sim->end_time;
@@ -200,7 +200,7 @@ static int choose_dt(mf_run *run, double next_write, double *dt, const char **li
     }
     if (!(*dt > 0) || !isfinite(*dt))
         return MF_ERROR(MF_ERR_NUMERIC, "the time step became %g at time %g", *dt, sim->time);
-    if (c->adjust && *dt < c->min_delta_t && run->natural_dt < c->min_delta_t)
+    if (c->adjust && *dt < c->min_delta_t && run->sim->dt_natural < c->min_delta_t)
         return diagnose_collapse(sim, *dt, c->min_delta_t, *limiter);
     return 0;
 }
@@ -254,7 +254,7 @@ static int step_once(mf_run *run, saved_state *saved, double next_write)
         sim->time = saved->time;
         run->retries++;
         dt *= 0.5;
-        run->natural_dt = dt;
+        run->sim->dt_natural = dt;
     }
     (void)limiter;
     sim->time += dt;

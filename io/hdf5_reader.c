@@ -53,6 +53,9 @@ static int read_header(hid_t file, const char *path, mf_hdf5_header *h)
     MF_CALL_GOTO(rc, mf_h5_attr_read(g, "NumPart_Total", H5T_NATIVE_INT64, MF_NKINDS, h->npart_total, what), done);
     MF_CALL_GOTO(rc, mf_h5_attr_read(g, "NextId", H5T_NATIVE_INT64, 0, &h->next_id, what), done);
     h->step = (long)step;
+    /* Optional (older snapshots lack it): the time-step controller's state. */
+    if (H5Aexists(g, "NaturalTimeStep") > 0)
+        MF_CALL_GOTO(rc, mf_h5_attr_read(g, "NaturalTimeStep", H5T_NATIVE_DOUBLE, 0, &h->dt_natural, what), done);
 
     /* CodeVersion is informational: read it if it is a readable string. */
     hid_t str = H5Tcopy(H5T_C_S1);
@@ -370,6 +373,7 @@ int mf_hdf5_read_snapshot(const char *path, mf_sim *sim)
     sim->time = h.time;
     sim->step = h.step;
     sim->dt = h.dt;
+    sim->dt_natural = h.dt_natural;
     if (sim->dim == 0)
         sim->dim = h.dim;
     if (sim->l0 == 0)

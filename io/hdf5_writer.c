@@ -41,6 +41,7 @@ static int write_header(const snap_writer *w, const mf_sim *sim,
     MF_CALL_GOTO(rc, mf_h5_attr_write(g, "Time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 0, &sim->time, what), done);
     MF_CALL_GOTO(rc, mf_h5_attr_write(g, "Step", H5T_STD_I64LE, H5T_NATIVE_INT64, 0, &step, what), done);
     MF_CALL_GOTO(rc, mf_h5_attr_write(g, "TimeStep", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 0, &sim->dt, what), done);
+    MF_CALL_GOTO(rc, mf_h5_attr_write(g, "NaturalTimeStep", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 0, &sim->dt_natural, what), done);
     MF_CALL_GOTO(rc, mf_h5_attr_write(g, "Dimension", H5T_STD_I32LE, H5T_NATIVE_INT, 0, &dim, what), done);
     MF_CALL_GOTO(rc, mf_h5_attr_write(g, "ParticleSpacing", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 0, &sim->l0, what), done);
     MF_CALL_GOTO(rc, mf_h5_attr_write(g, "NumPart_ThisFile", H5T_STD_I64LE, H5T_NATIVE_INT64, MF_NKINDS, counts, what), done);

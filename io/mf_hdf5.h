@@ -7,7 +7,7 @@
  *   <case>/output/particles.xdmf      the index ParaView opens
  *
  * A snapshot holds
- *   /Header       attributes Time, Step, TimeStep, Dimension, ParticleSpacing,
+ *   /Header       attributes Time, Step, TimeStep, NaturalTimeStep, Dimension, ParticleSpacing,
  *                 NumPart_ThisFile[5], NumPart_Total[5], NextId, Code,
  *                 CodeVersion, Flag_Restart, NumFilesPerSnapshot
  *   /Parameters   the resolved case dictionary: sub-dictionaries are groups,
@@ -55,6 +55,7 @@ typedef struct mf_hdf5_header {
     double time;
     long step;
     double dt;                     /* TimeStep: the last step taken */
+    double dt_natural;             /* NaturalTimeStep: the step controller's state (0 if absent) */
     int dim;
     double l0;                     /* ParticleSpacing */
     int64_t npart[MF_NKINDS];      /* NumPart_ThisFile */

@@ -13,6 +13,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "mf_dictio.h"
 #include "mf_error.h"
 
 static double wall_now(void)
@@ -407,4 +408,31 @@ size_t tc_count_kind(const mf_particles *p, int kind)
     for (size_t i = 0; i < p->n; i++)
         n += p->kind[i] == kind;
     return n;
+}
+
+int tc_resolved_number(const char *case_dir, const char *key_path, double *out)
+{
+    char path[700], keys[256];
+    snprintf(path, sizeof path, "%s/output/resolvedParameters", case_dir);
+    snprintf(keys, sizeof keys, "%s", key_path);
+    mf_dict *root = NULL;
+    int rc = mf_dict_parse_file(path, &root);
+    const mf_dict *d = root;
+    char *save = NULL, *key = strtok_r(keys, "/", &save);
+    while (rc == 0 && key) {
+        char *next = strtok_r(NULL, "/", &save);
+        if (!next) {
+            rc = mf_dict_get_number(d, key, out);
+        } else if (!(d = mf_dict_subdict(d, key))) {
+            rc = MF_ERROR(MF_ERR_INPUT, "%s: no sub-dictionary '%s' on the way to %s", path, key,
+                          key_path);
+        }
+        key = next;
+    }
+    if (rc != 0) {
+        fprintf(stderr, "case_util: cannot read %s from %s:\n", key_path, path);
+        mf_error_print(stderr);
+    }
+    mf_dict_free(root);
+    return rc;
 }

@@ -85,6 +85,10 @@ void tc_sim_free(mf_sim *sim);
 const double *tc_field_d(const mf_particles *p, const char *name);
 const int32_t *tc_field_i(const mf_particles *p, const char *name);
 
+/* A number of the run's resolved parameters (DIR/output/resolvedParameters),
+ * by a path of keys such as "solverDict/MPSCoeffs/reNumberDensity". */
+int tc_resolved_number(const char *case_dir, const char *key_path, double *out);
+
 /* Fluid particles in a snapshot. */
 size_t tc_count_kind(const mf_particles *p, int kind);
 
