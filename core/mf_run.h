@@ -14,6 +14,7 @@
 
 #include "mf_modules.h"
 #include "mf_sim.h"
+#include "mf_watch.h"
 
 typedef struct mf_run_control {
     double delta_t;      /* first (or fixed) step */
@@ -35,6 +36,7 @@ typedef struct mf_run {
     size_t nfunctions;
     mf_module *functions;            /* function objects */
     const mf_dict *params;           /* resolved case, handed to the writer */
+    mf_watch watch;                  /* checks after every step (mf_watch_init first) */
     /* Filled by the loop. */
     long steps, retries;
     double wall_seconds;

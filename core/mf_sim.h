@@ -31,6 +31,13 @@ typedef struct mf_module {
     void *data;     /* the module's own state (from create) */
 } mf_module;
 
+/* A wall box as the scene built it: the region it encloses and which faces
+ * are open. The run's watch uses it to see particles that pass a wall. */
+typedef struct mf_wall_box {
+    double min[3], max[3];
+    bool open[3][2];
+} mf_wall_box;
+
 typedef struct mf_sim {
     int dim;
     double l0;                 /* particle spacing */
@@ -52,6 +59,16 @@ typedef struct mf_sim {
     /* Modules the case names, in order. */
     size_t nforces;
     mf_module *forces;         /* kind MF_KIND_FORCE */
+    /* Neighbours of the particles at their current positions (radius:
+     * neighbours->radius), set by the solver while forces accumulate and NULL
+     * otherwise: a force that needs neighbours uses it when the radius is
+     * large enough, else builds its own. */
+    const mf_nlist *neighbours;
+    /* Walls of the scene (box walls), for the watch. */
+    size_t nwall_boxes;
+    mf_wall_box *wall_boxes;
+    /* n0 of the solver's number density (0: the solver has none), for the watch. */
+    double n0;
     const mf_registry *reg;
     mf_log *log;
     /* Statistics the driver reports (filled by modules). */

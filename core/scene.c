@@ -3,6 +3,7 @@
 
 #include <math.h>
 #include <stddef.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "mf_error.h"
@@ -224,6 +225,21 @@ static int parse_open_faces(const mf_dict *d, const char *name, bool open[3][2])
     return 0;
 }
 
+static int record_wall_box(mf_sim *sim, const double *mn, const double *mx, bool open[3][2])
+{
+    mf_wall_box *grown = realloc(sim->wall_boxes, (sim->nwall_boxes + 1) * sizeof *grown);
+    if (!grown)
+        return MF_ERROR(MF_ERR_MEMORY, "out of memory");
+    sim->wall_boxes = grown;
+    mf_wall_box *b = &sim->wall_boxes[sim->nwall_boxes++];
+    memcpy(b->min, mn, sizeof b->min);
+    memcpy(b->max, mx, sizeof b->max);
+    memcpy(b->open, open, sizeof b->open);
+    if (sim->dim == 2) /* no z faces in 2-D */
+        b->open[2][0] = b->open[2][1] = true;
+    return 0;
+}
+
 /* A lattice point k steps outside the region is in layer k: the first
  * wallLayers are MF_WALL, the rest MF_DUMMY. */
 static int add_wall_box(mf_sim *sim, const char *name, const mf_dict *d, mf_dict *resolved)
@@ -234,6 +250,7 @@ static int add_wall_box(mf_sim *sim, const char *name, const mf_dict *d, mf_dict
     MF_CALL(check_box("wall", name, d, s.min, s.max, sim->dim));
     bool open[3][2];
     MF_CALL(parse_open_faces(d, name, open));
+    MF_CALL(record_wall_box(sim, s.min, s.max, open));
     const double l0 = sim->l0;
     const long layers = s.wall_layers + s.dummy_layers;
     long lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1}, n[3] = {1, 1, 1};

@@ -233,6 +233,11 @@ int mf_app_setup(mf_app *app)
     run->nfunctions = app->nfunctions;
     run->functions = app->functions;
     run->params = resolved;
+    const mf_dict *wd = mf_dict_subdict(app->cs.control_dict, "watch");
+    if (wd)
+        mf_dict_find(app->cs.control_dict, "watch")->used = true;
+    MF_CALL(mf_watch_init(&run->watch, wd,
+                          mf_dict_set_subdict(mf_dict_subdict(resolved, "controlDict"), "watch")));
     return 0;
 }
 
@@ -258,6 +263,8 @@ void mf_app_teardown(mf_app *app)
         mf_module_release(&app->sim.forces[k]);
     }
     free(app->sim.forces);
+    free(app->sim.wall_boxes);
+    mf_watch_free(&app->run.watch);
     mf_particles_destroy(app->sim.p);
     mf_case_free(&app->cs);
 }

@@ -71,7 +71,8 @@ int mf_case_read(const char *dir, mf_case *c)
     c->resolved = mf_dict_new("", NULL);
     if (!c->resolved)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory");
-    static const char *const extra[] = {"FoamFile", "libs", "functions", NULL};
+    static const char *const extra[] = {"FoamFile", "libs", "functions", "watch", "writerCoeffs",
+                                        NULL};
     MF_CALL(mf_params_apply(mf_control_params, mf_control_nparams, c->control_dict, extra,
                             &c->control, mf_dict_set_subdict(c->resolved, "controlDict")));
     if (c->control.end_time <= c->control.start_time) {

@@ -1,0 +1,220 @@
+/* watch.c: the checks of mf_watch.h. */
+#include "mf_watch.h"
+
+#include <math.h>
+#include <stddef.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mf_error.h"
+#include "mf_modules.h"
+
+const mf_param mf_watch_params[] = {
+    {"enabled", MF_PARAM_BOOL, "yes", MF_NO_RANGE, NULL, offsetof(mf_watch_settings, enabled),
+     "check every step for the signs of instability"},
+    {"energyTolerance", MF_PARAM_SCALAR, "0.25", 1e-6, 1e6, NULL,
+     offsetof(mf_watch_settings, energy_tolerance),
+     "kinetic energy gained without a source, as a fraction of the run's energy scale"},
+    {"densityCollapse", MF_PARAM_SCALAR, "0.5", 0, 1, NULL,
+     offsetof(mf_watch_settings, density_collapse),
+     "mean fluid number density below this fraction of n0 means the fluid blew apart"},
+};
+const size_t mf_watch_nparams = sizeof mf_watch_params / sizeof mf_watch_params[0];
+
+int mf_watch_init(mf_watch *w, const mf_dict *dict, mf_dict *resolved)
+{
+    memset(w, 0, sizeof *w);
+    static const char *const extra[] = {NULL};
+    MF_CALL(mf_params_apply(mf_watch_params, mf_watch_nparams, dict, extra, &w->s, resolved));
+    return 0;
+}
+
+void mf_watch_free(mf_watch *w)
+{
+    free(w->acc);
+    w->acc = NULL;
+}
+
+/* Mass of particle i: rho l0^d of its fluid (FluidId when there are several). */
+static double particle_mass(const mf_sim *sim, int fluid_field, size_t i)
+{
+    int f = fluid_field >= 0 ? mf_particles_fi(sim->p, fluid_field)[i] : 0;
+    double vol = sim->dim == 3 ? sim->l0 * sim->l0 * sim->l0 : sim->l0 * sim->l0;
+    return sim->fluid[f].rho * vol;
+}
+
+static int check_non_finite(const mf_sim *sim)
+{
+    const mf_particles *p = sim->p;
+    for (size_t i = 0; i < p->n_owned; i++) {
+        const char *what = NULL;
+        for (int c = 0; c < 3 && !what; c++) {
+            if (!isfinite(p->pos[3 * i + c])) what = "position";
+            else if (!isfinite(p->vel[3 * i + c])) what = "velocity";
+        }
+        for (int f = 0; f < p->nfields && !what; f++) {
+            const mf_field *fd = &p->field[f];
+            if (fd->type != MF_FIELD_DOUBLE)
+                continue;
+            for (int c = 0; c < fd->ncomp; c++)
+                if (!isfinite(((const double *)fd->data)[fd->ncomp * i + c]))
+                    what = fd->name;
+        }
+        if (what)
+            return MF_ERROR(MF_ERR_NUMERIC,
+                            "unstable (nonFinite) at time %g, step %ld: %s particle id %lld has a "
+                            "non-finite %s",
+                            sim->time, sim->step, mf_particle_kind_name(p->kind[i]),
+                            (long long)p->id[i], what);
+    }
+    return 0;
+}
+
+/* A fluid centre past the wall-particle line (l0/2 outside the enclosed
+ * region) of a closed face, within that face's extent, went through it. */
+static int check_walls(const mf_sim *sim)
+{
+    const mf_particles *p = sim->p;
+    const double h = 0.5 * sim->l0;
+    for (size_t b = 0; b < sim->nwall_boxes; b++) {
+        const mf_wall_box *box = &sim->wall_boxes[b];
+        for (size_t i = 0; i < p->n_owned; i++) {
+            if (p->kind[i] != MF_FLUID)
+                continue;
+            const double *x = &p->pos[3 * i];
+            for (int a = 0; a < sim->dim; a++) {
+                for (int side = 0; side < 2; side++) {
+                    if (box->open[a][side])
+                        continue;
+                    bool past = side == 0 ? x[a] < box->min[a] - h : x[a] > box->max[a] + h;
+                    if (!past)
+                        continue;
+                    bool within = true;
+                    for (int o = 0; o < sim->dim; o++)
+                        if (o != a && (x[o] < box->min[o] - h || x[o] > box->max[o] + h))
+                            within = false;
+                    if (!within)
+                        continue;
+                    static const char *const faces[3][2] = {
+                        {"xmin", "xmax"}, {"ymin", "ymax"}, {"zmin", "zmax"}};
+                    return MF_ERROR(MF_ERR_NUMERIC,
+                                    "unstable (throughWall) at time %g, step %ld: fluid particle "
+                                    "id %lld at (%g %g %g) is past the %s wall of wall box %zu, "
+                                    "moving at (%g %g %g) m/s",
+                                    sim->time, sim->step, (long long)p->id[i], x[0], x[1], x[2],
+                                    faces[a][side], b + 1, p->vel[3 * i], p->vel[3 * i + 1],
+                                    p->vel[3 * i + 2]);
+                }
+            }
+        }
+    }
+    return 0;
+}
+
+static int check_density(const mf_watch *w, const mf_sim *sim)
+{
+    int fn = mf_particles_field_index(sim->p, "NumberDensity");
+    if (sim->n0 <= 0 || fn < 0 || w->s.density_collapse <= 0)
+        return 0;
+    const double *n = mf_particles_fd(sim->p, fn);
+    double sum = 0;
+    size_t count = 0;
+    for (size_t i = 0; i < sim->p->n_owned; i++)
+        if (sim->p->kind[i] == MF_FLUID) {
+            sum += n[i];
+            count++;
+        }
+    if (count == 0 || sum / count >= w->s.density_collapse * sim->n0)
+        return 0;
+    return MF_ERROR(MF_ERR_NUMERIC,
+                    "unstable (densityCollapse) at time %g, step %ld: the mean number density "
+                    "of the fluid is %.3g n0, below densityCollapse %g: the fluid has blown apart",
+                    sim->time, sim->step, sum / count / sim->n0, w->s.density_collapse);
+}
+
+/* Kinetic energy, and the power of the force modules (sum m a.v). */
+static int energy(mf_watch *w, const mf_sim *sim, double *ke, double *power, double *mass_acc)
+{
+    const mf_particles *p = sim->p;
+    if (w->cap < p->n) {
+        free(w->acc);
+        w->cap = p->n + p->n / 4 + 16;
+        w->acc = malloc(3 * w->cap * sizeof *w->acc);
+        if (!w->acc)
+            return MF_ERROR(MF_ERR_MEMORY, "out of memory in the run's watch");
+    }
+    memset(w->acc, 0, 3 * p->n * sizeof *w->acc);
+    for (size_t k = 0; k < sim->nforces; k++) {
+        const mf_force_ops *ops = (const mf_force_ops *)sim->forces[k].info;
+        MF_CALL(ops->accumulate(sim->forces[k].data, sim, w->acc));
+    }
+    int ff = mf_particles_field_index(p, "FluidId");
+    *ke = *power = *mass_acc = 0;
+    for (size_t i = 0; i < p->n_owned; i++) {
+        if (p->kind[i] != MF_FLUID)
+            continue;
+        const double m = particle_mass(sim, ff, i), *v = &p->vel[3 * i], *a = &w->acc[3 * i];
+        *ke += 0.5 * m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        *power += m * (a[0] * v[0] + a[1] * v[1] + a[2] * v[2]);
+        *mass_acc += m * sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    }
+    return 0;
+}
+
+static double fluid_extent(const mf_sim *sim)
+{
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t i = 0; i < sim->p->n_owned; i++)
+        for (int c = 0; c < 3; c++) {
+            lo[c] = fmin(lo[c], sim->p->pos[3 * i + c]);
+            hi[c] = fmax(hi[c], sim->p->pos[3 * i + c]);
+        }
+    double L = 0;
+    for (int c = 0; c < sim->dim; c++)
+        L = fmax(L, hi[c] - lo[c]);
+    return L;
+}
+
+static int check_energy(mf_watch *w, const mf_sim *sim, double dt)
+{
+    double ke = 0, power = 0, mass_acc = 0;
+    MF_CALL(energy(w, sim, &ke, &power, &mass_acc));
+    if (!w->started) { /* the state the run starts from (after its first step) */
+        w->started = true;
+        w->ke0 = ke;
+        w->pot_scale = mass_acc * fluid_extent(sim);
+        w->next_work = 0;
+        w->next_power = power;
+        return 0;
+    }
+    /* Trapezoidal rule between the last accepted step and this one. */
+    w->next_work = w->work + 0.5 * (w->power + power) * dt;
+    w->next_power = power;
+    double excess = ke - w->ke0 - w->next_work;
+    double scale = w->ke0 + fabs(w->next_work) + w->pot_scale;
+    if (scale > 0 && excess > w->s.energy_tolerance * scale)
+        return MF_ERROR(MF_ERR_NUMERIC,
+                        "unstable (energy) at time %g, step %ld: the fluid's kinetic energy %g J "
+                        "exceeds its start %g J plus the work of the forces %g J by %g J, more "
+                        "than energyTolerance %g of the energy scale %g J",
+                        sim->time, sim->step, ke, w->ke0, w->next_work, excess,
+                        w->s.energy_tolerance, scale);
+    return 0;
+}
+
+int mf_watch_check(mf_watch *w, const mf_sim *sim, double dt)
+{
+    MF_CALL(check_non_finite(sim));
+    if (!w->s.enabled)
+        return 0;
+    MF_CALL(check_walls(sim));
+    MF_CALL(check_density(w, sim));
+    MF_CALL(check_energy(w, sim, dt));
+    return 0;
+}
+
+void mf_watch_accept(mf_watch *w)
+{
+    w->work = w->next_work;
+    w->power = w->next_power;
+}
