@@ -23,6 +23,8 @@ static void usage(FILE *f)
             "  (none)            run the case\n"
             "  modules [NAME]    list the registered modules by kind, or the parameters of one\n"
             "  validate          score the case's output against its reference (validation/)\n"
+            "  compare           run the case with several schemes and resolutions: error\n"
+            "                    against run time (-solvers '(A B)' -resolutions '(l0 ...)')\n"
             "\n"
             "Options:\n"
             "  -case DIR         case directory (default: the current folder)\n"
@@ -32,6 +34,8 @@ static void usage(FILE *f)
             "  -latestTime       restart from the newest snapshot in DIR/output\n"
             "  -l0 VALUE         particle spacing, overriding constant/geometry (coarse/fine)\n"
             "  -endTime VALUE    end time, overriding system/controlDict\n"
+            "  -solvers '(...)'  compare: schemes (variants of system/compareDict, or solvers)\n"
+            "  -resolutions '(...)'  compare: particle spacings\n"
             "  -quiet, -verbose  less or more log\n"
             "  -help             this text\n"
             "\n"
@@ -52,7 +56,8 @@ static int parse_number(const char *opt, const char *text, double *out)
 static int parse_options(int argc, char **argv, int first, mf_options *opt)
 {
     static const char *const known[] = {"-case", "-solver", "-libs", "-dryRun", "-latestTime",
-                                        "-l0", "-endTime", "-quiet", "-verbose", "-help"};
+                                        "-l0", "-endTime", "-quiet", "-verbose", "-help",
+                                        "-solvers", "-resolutions"};
     for (int i = first; i < argc; i++) {
         const char *a = argv[i];
         bool has_value = i + 1 < argc;
@@ -67,7 +72,8 @@ static int parse_options(int argc, char **argv, int first, mf_options *opt)
         else if (!strcmp(a, "-verbose"))
             opt->log_level = MF_LOG_VERBOSE;
         else if (!strcmp(a, "-case") || !strcmp(a, "-solver") || !strcmp(a, "-libs") ||
-                 !strcmp(a, "-l0") || !strcmp(a, "-endTime")) {
+                 !strcmp(a, "-l0") || !strcmp(a, "-endTime") || !strcmp(a, "-solvers") ||
+                 !strcmp(a, "-resolutions")) {
             if (!has_value)
                 return MF_ERROR(MF_ERR_INPUT, "option %s needs a value (see mpsflow -help)", a);
             const char *v = argv[++i];
@@ -77,6 +83,10 @@ static int parse_options(int argc, char **argv, int first, mf_options *opt)
                 opt->solver = v;
             else if (!strcmp(a, "-libs"))
                 opt->libs = v;
+            else if (!strcmp(a, "-solvers"))
+                opt->solvers = v;
+            else if (!strcmp(a, "-resolutions"))
+                opt->resolutions = v;
             else if (!strcmp(a, "-l0"))
                 MF_CALL(parse_number(a, v, &opt->l0));
             else
@@ -165,6 +175,8 @@ int mf_cmd_run(mf_app *app)
                   "MB\n",
                   app->run.steps, app->run.retries, app->run.writes, app->run.wall_seconds,
                   mf_peak_memory() / 1048576.0);
+    if (mf_write_run_summary(app, rc) != 0 && rc == 0)
+        return mf_error_trace(MF_ERR_IO, __FILE__, __LINE__, __func__);
     MF_CALL(rc);
     mf_log_printf(&app->log, MF_LOG_QUIET, "End\n");
     return 0;
@@ -196,9 +208,13 @@ int main(int argc, char **argv)
         mf_error_print(stderr);
         return 2;
     }
-    if (command && strcmp(command, "modules") != 0 && strcmp(command, "validate") != 0) {
-        static const char *const commands[] = {"modules", "validate"};
-        const char *hint = mf_did_you_mean(command, commands, 2);
+    static const char *const commands[] = {"modules", "validate", "compare"};
+    const size_t ncommands = sizeof commands / sizeof commands[0];
+    bool known = !command;
+    for (size_t k = 0; k < ncommands && !known; k++)
+        known = !strcmp(command, commands[k]);
+    if (!known) {
+        const char *hint = mf_did_you_mean(command, commands, ncommands);
         fprintf(stderr, "mpsflow: unknown command '%s'%s%s%s\n\n", command,
                 hint ? " (did you mean '" : "", hint ? hint : "", hint ? "'?)" : "");
         usage(stderr);
@@ -218,8 +234,10 @@ int main(int argc, char **argv)
         rc = mf_cmd_run(&app);
     else if (rc == 0 && !strcmp(command, "modules"))
         rc = mf_cmd_modules(app.reg, module_name);
-    else if (rc == 0)
+    else if (rc == 0 && !strcmp(command, "validate"))
         rc = mf_cmd_validate(app.opt.case_dir, &error);
+    else if (rc == 0 && !strcmp(command, "compare"))
+        rc = mf_cmd_compare(app.opt.case_dir, app.opt.solvers, app.opt.resolutions);
     if (rc != 0)
         mf_error_print(stderr);
     mf_app_teardown(&app);

@@ -13,6 +13,7 @@ typedef struct mf_options {
     const char *case_dir;
     const char *solver;     /* -solver overrides solverDict */
     const char *libs;       /* -libs '(a b)' */
+    const char *solvers, *resolutions; /* compare */
     double l0;              /* -l0 overrides particleSpacing (0: no) */
     double end_time;        /* -endTime overrides controlDict (0: no) */
     bool dry_run, latest_time;
@@ -41,6 +42,9 @@ int mf_app_setup(mf_app *app);
 void mf_app_teardown(mf_app *app);
 /* Print counts, kernel constants and memory (-dryRun). */
 void mf_app_summary(const mf_app *app);
+
+/* output/runSummary: how the run ended (status is its return code). */
+int mf_write_run_summary(const mf_app *app, int status);
 
 /* Commands. */
 int mf_cmd_run(mf_app *app);

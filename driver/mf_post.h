@@ -25,6 +25,9 @@ extern const mf_metric mf_metric_hydrostatic;
 /* `mpsflow validate -case DIR`: prints "error <metric> = <value>". */
 int mf_cmd_validate(const char *case_dir, double *error);
 
+/* `mpsflow compare`: see compare.c. */
+int mf_cmd_compare(const char *case_dir, const char *solvers, const char *resolutions);
+
 /* Linear interpolation of y(x) at xq on ascending x; NAN outside. */
 double mf_interp(const double *x, const double *y, size_t n, double xq);
 /* Read a two-column CSV with '#' comments and one header line. */

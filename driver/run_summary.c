@@ -1,0 +1,61 @@
+/* run_summary.c: output/runSummary, the machine-readable end of a run
+ * (status, criterion, counts, times), read by `mpsflow compare` and the
+ * stability sweep. Written even when the run fails. */
+#include <errno.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "mf_app.h"
+#include "mf_error.h"
+
+/* "unstable (energy) at time ..." -> "energy"; other failures -> "" */
+static void criterion_of(const char *message, char *out, size_t len)
+{
+    out[0] = '\0';
+    const char *s = strstr(message, "unstable (");
+    if (!s)
+        return;
+    s += strlen("unstable (");
+    size_t n = strcspn(s, ")");
+    if (n < len) {
+        memcpy(out, s, n);
+        out[n] = '\0';
+    }
+}
+
+int mf_write_run_summary(const mf_app *app, int status)
+{
+    char dir[4200], path[4300], tmp[4400], criterion[64];
+    snprintf(dir, sizeof dir, "%s/output", app->cs.dir);
+    if (mkdir(dir, 0777) != 0 && errno != EEXIST)
+        return MF_ERROR(MF_ERR_IO, "%s: cannot create (%s)", dir, strerror(errno));
+    snprintf(path, sizeof path, "%s/runSummary", dir);
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    const char *message = status ? mf_error_message() : "";
+    criterion_of(message, criterion, sizeof criterion);
+    FILE *f = fopen(tmp, "w");
+    if (!f)
+        return MF_ERROR(MF_ERR_IO, "%s: cannot write (%s)", tmp, strerror(errno));
+    const mf_sim *sim = &app->sim;
+    fprintf(f, "// How this run ended (written by mpsflow %s).\n", MPSFLOW_VERSION);
+    fprintf(f, "status              %s;\n",
+            status == 0 ? "completed" : (criterion[0] || status == MF_ERR_NUMERIC ? "unstable" : "failed"));
+    fprintf(f, "criterion           %s;\n", criterion[0] ? criterion : (status ? "other" : "none"));
+    fprintf(f, "message             \"");
+    for (const char *c = message; *c; c++) /* a dictionary string: escape quotes */
+        fprintf(f, "%s%c", (*c == '"' || *c == '\\') ? "\\" : "", *c == '\n' ? ' ' : *c);
+    fprintf(f, "\";\n");
+    fprintf(f, "solver              %s;\n", app->solver.info ? app->solver.info->name : "none");
+    fprintf(f, "particleSpacing     %.10g;\n", sim->l0);
+    fprintf(f, "particles           %zu;\n", sim->p ? sim->p->n : 0);
+    fprintf(f, "time                %.10g;\n", sim->time);
+    fprintf(f, "endTime             %.10g;\n", sim->end_time);
+    fprintf(f, "steps               %ld;\n", app->run.steps);
+    fprintf(f, "retries             %ld;\n", app->run.retries);
+    fprintf(f, "pressureIterations  %ld;\n", sim->pressure_iterations);
+    fprintf(f, "wallSeconds         %.6g;\n", app->run.wall_seconds);
+    fprintf(f, "peakMemoryMB        %.6g;\n", mf_peak_memory() / 1048576.0);
+    if (fclose(f) != 0 || rename(tmp, path) != 0)
+        return MF_ERROR(MF_ERR_IO, "%s: cannot write (%s)", path, strerror(errno));
+    return 0;
+}
