@@ -288,9 +288,13 @@ static int bounding_box(const mf_particles *p, size_t n, double lo[3], double hi
         for (size_t i = 0; i < n; i++) {
             const double *x = pos + 3 * i;
             if (!isfinite(x[0]) || !isfinite(x[1]) || (dim == 3 && !isfinite(x[2])))
+                /* Named as the run's watch names it (mf_watch.h). */
                 return MF_ERROR(MF_ERR_NUMERIC,
-                                "particle %zu has a non-finite position (%g, %g, %g); %zu such",
-                                i, x[0], x[1], x[2], bad);
+                                "unstable (nonFinite): %s particle id %lld has a non-finite "
+                                "position (%g, %g, %g), %zu particles in all, found building the "
+                                "neighbour grid",
+                                mf_particle_kind_name(p->kind[i]), (long long)p->id[i], x[0],
+                                x[1], x[2], bad);
         }
     }
     lo[0] = x0, lo[1] = y0, lo[2] = z0;
