@@ -84,8 +84,12 @@ static void write_report(const char *case_dir, compare_row *rows, size_t n)
     }
     snprintf(path, sizeof path, "%s/compare/compare.png", case_dir);
     char title[512];
-    snprintf(title, sizeof title, "Error against run time: %s (labels: l0)", case_dir);
-    mf_plot plot = {title, "wall time, s", "error (validation/metric)", true, true};
+    char full[4096];
+    const char *name = realpath(case_dir, full) ? full : case_dir;
+    const char *slash = strrchr(name, '/');
+    snprintf(title, sizeof title, "Error against run time: %.200s (labels: l0)",
+             slash && slash[1] ? slash + 1 : name);
+    mf_plot plot = {title, "wall time, s", "error (validation/metric)", true, true, NULL};
     if (mf_report_plot(path, &plot, series, ns) != 0) {
         fprintf(stderr, "%s\n", mf_error_message());
         mf_error_clear();

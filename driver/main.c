@@ -25,6 +25,8 @@ static void usage(FILE *f)
             "  validate          score the case's output against its reference (validation/)\n"
             "  compare           run the case with several schemes and resolutions: error\n"
             "                    against run time (-solvers '(A B)' -resolutions '(l0 ...)')\n"
+            "  stability         sweep system/stabilityDict's parameters for each scheme and\n"
+            "                    map stable and unstable runs (-solvers '(A B)' [-sweeps '(...)'])\n"
             "\n"
             "Options:\n"
             "  -case DIR         case directory (default: the current folder)\n"
@@ -36,6 +38,7 @@ static void usage(FILE *f)
             "  -endTime VALUE    end time, overriding system/controlDict\n"
             "  -solvers '(...)'  compare: schemes (variants of system/compareDict, or solvers)\n"
             "  -resolutions '(...)'  compare: particle spacings\n"
+            "  -sweeps '(...)'   stability: only these sweeps\n"
             "  -quiet, -verbose  less or more log\n"
             "  -help             this text\n"
             "\n"
@@ -57,7 +60,7 @@ static int parse_options(int argc, char **argv, int first, mf_options *opt)
 {
     static const char *const known[] = {"-case", "-solver", "-libs", "-dryRun", "-latestTime",
                                         "-l0", "-endTime", "-quiet", "-verbose", "-help",
-                                        "-solvers", "-resolutions"};
+                                        "-solvers", "-resolutions", "-sweeps"};
     for (int i = first; i < argc; i++) {
         const char *a = argv[i];
         bool has_value = i + 1 < argc;
@@ -73,7 +76,7 @@ static int parse_options(int argc, char **argv, int first, mf_options *opt)
             opt->log_level = MF_LOG_VERBOSE;
         else if (!strcmp(a, "-case") || !strcmp(a, "-solver") || !strcmp(a, "-libs") ||
                  !strcmp(a, "-l0") || !strcmp(a, "-endTime") || !strcmp(a, "-solvers") ||
-                 !strcmp(a, "-resolutions")) {
+                 !strcmp(a, "-resolutions") || !strcmp(a, "-sweeps")) {
             if (!has_value)
                 return MF_ERROR(MF_ERR_INPUT, "option %s needs a value (see mpsflow -help)", a);
             const char *v = argv[++i];
@@ -87,6 +90,8 @@ static int parse_options(int argc, char **argv, int first, mf_options *opt)
                 opt->solvers = v;
             else if (!strcmp(a, "-resolutions"))
                 opt->resolutions = v;
+            else if (!strcmp(a, "-sweeps"))
+                opt->sweeps = v;
             else if (!strcmp(a, "-l0"))
                 MF_CALL(parse_number(a, v, &opt->l0));
             else
@@ -208,7 +213,7 @@ int main(int argc, char **argv)
         mf_error_print(stderr);
         return 2;
     }
-    static const char *const commands[] = {"modules", "validate", "compare"};
+    static const char *const commands[] = {"modules", "validate", "compare", "stability"};
     const size_t ncommands = sizeof commands / sizeof commands[0];
     bool known = !command;
     for (size_t k = 0; k < ncommands && !known; k++)
@@ -238,6 +243,8 @@ int main(int argc, char **argv)
         rc = mf_cmd_validate(app.opt.case_dir, &error);
     else if (rc == 0 && !strcmp(command, "compare"))
         rc = mf_cmd_compare(app.opt.case_dir, app.opt.solvers, app.opt.resolutions);
+    else if (rc == 0 && !strcmp(command, "stability"))
+        rc = mf_cmd_stability(app.opt.case_dir, app.opt.solvers, app.opt.sweeps);
     if (rc != 0)
         mf_error_print(stderr);
     mf_app_teardown(&app);

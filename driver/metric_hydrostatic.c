@@ -117,7 +117,7 @@ static int evaluate(const char *case_dir, const mf_dict *md, double *error)
         snprintf(path, sizeof path, "%s/validation/result.png", case_dir);
         char title[256];
         snprintf(title, sizeof title, "Hydrostatic pressure (RMS relative error %.3g)", *error);
-        mf_plot plot = {title, "p, Pa", "y, m", false, false};
+        mf_plot plot = {title, "p, Pa", "y, m", false, false, NULL};
         mf_series series[2] = {{"mpsflow (time average)", pavg, y, nb, "points pt 7", NULL},
                                {"rho g (H - y)", pex, y, nb, "lines lw 2", NULL}};
         rc = mf_report_plot(path, &plot, series, 2);

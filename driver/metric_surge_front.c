@@ -131,7 +131,7 @@ static int evaluate(const char *case_dir, const mf_dict *md, double *error)
         snprintf(path, sizeof path, "%s/validation/result.png", case_dir);
         char title[256];
         snprintf(title, sizeof title, "Dam break surge front (RMS error of Z = %.3g)", *error);
-        mf_plot plot = {title, "T = t sqrt(2g/a)", "Z = z/a", false, false};
+        mf_plot plot = {title, "T = t sqrt(2g/a)", "Z = z/a", false, false, NULL};
         mf_series series[2] = {
             {"mpsflow", T, Z, n, "lines lw 2", NULL},
             {s.reference, Tref, Zref, nref, "points pt 7 ps 1.5", NULL},

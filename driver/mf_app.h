@@ -13,7 +13,7 @@ typedef struct mf_options {
     const char *case_dir;
     const char *solver;     /* -solver overrides solverDict */
     const char *libs;       /* -libs '(a b)' */
-    const char *solvers, *resolutions; /* compare */
+    const char *solvers, *resolutions, *sweeps; /* compare, stability */
     double l0;              /* -l0 overrides particleSpacing (0: no) */
     double end_time;        /* -endTime overrides controlDict (0: no) */
     bool dry_run, latest_time;

@@ -28,6 +28,9 @@ int mf_cmd_validate(const char *case_dir, double *error);
 /* `mpsflow compare`: see compare.c. */
 int mf_cmd_compare(const char *case_dir, const char *solvers, const char *resolutions);
 
+/* `mpsflow stability`: see stability.c. */
+int mf_cmd_stability(const char *case_dir, const char *solvers, const char *sweeps);
+
 /* Linear interpolation of y(x) at xq on ascending x; NAN outside. */
 double mf_interp(const double *x, const double *y, size_t n, double xq);
 /* Read a two-column CSV with '#' comments and one header line. */

@@ -17,6 +17,7 @@ typedef struct mf_series {
 typedef struct mf_plot {
     const char *title, *xlabel, *ylabel;
     bool logx, logy;
+    const char *extra; /* further gnuplot commands before `plot` (may be NULL) */
 } mf_plot;
 
 /* Write a CSV file (temp + rename): a '#' comment block (may be NULL), a

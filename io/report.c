@@ -54,7 +54,8 @@ int mf_report_plot(const char *png, const mf_plot *plot, const mf_series *series
     if (!g)
         return MF_ERROR(MF_ERR_IO, "cannot start gnuplot (%s): install it with "
                         "apt-get install gnuplot-nox", strerror(errno));
-    fprintf(g, "set terminal pngcairo size 900,600 font 'sans,11'\nset output ");
+    /* noenhanced: names such as MPS_plain are not subscripts. */
+    fprintf(g, "set terminal pngcairo noenhanced size 900,600 font 'sans,11'\nset output ");
     put_quoted(g, tmp);
     fprintf(g, "\nset title ");
     put_quoted(g, plot->title);
@@ -65,13 +66,14 @@ int mf_report_plot(const char *png, const mf_plot *plot, const mf_series *series
     fprintf(g, "\nset grid\nset key left top\n");
     if (plot->logx) fprintf(g, "set logscale x\n");
     if (plot->logy) fprintf(g, "set logscale y\n");
+    if (plot->extra) fprintf(g, "%s\n", plot->extra);
     fprintf(g, "plot ");
     for (size_t s = 0; s < nseries; s++) {
         fprintf(g, "%s'-' using 1:2 with %s title ", s ? ", " : "",
                 series[s].style ? series[s].style : "linespoints");
         put_quoted(g, series[s].title);
         if (series[s].labels)
-            fprintf(g, ", '-' using 1:2:3 with labels offset 1,1 notitle");
+            fprintf(g, ", '-' using 1:2:3 with labels offset 0,1.2 font ',8' notitle");
     }
     fprintf(g, "\n");
     for (size_t s = 0; s < nseries; s++) {
