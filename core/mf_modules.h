@@ -103,10 +103,18 @@ typedef struct mf_writer_ops {
 } mf_writer_ops;
 
 /* ---- surface reconstructor (level set, blobby) --------------------------- */
+struct mf_mesh; /* core/mf_mesh.h */
 typedef struct mf_surface_ops {
     mf_module_info info;
     int (*create)(const void *settings, void **data);
     void (*destroy)(void *data);
+    /* Added with the level set (solvers/levelset). Reconstruct the surface of
+     * the fluid particles (kind MF_FLUID) of sim at sim->time into out
+     * (replacing its contents). A module may keep state between calls: the
+     * level set starts each frame from the previous one's. Bad input (no
+     * fluid particle, a non-finite position, a grid too fine for memory) is
+     * MF_ERR_INPUT or MF_ERR_MEMORY with a message saying what to change. */
+    int (*reconstruct)(void *data, const mf_sim *sim, struct mf_mesh *out);
 } mf_surface_ops;
 
 /* ---- creating a module from a case ------------------------------------- */

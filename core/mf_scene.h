@@ -29,6 +29,13 @@ int mf_scene_read_fluids(const mf_dict *fluids, mf_sim *sim);
  * With more than one fluid, a "FluidId" field is created; with one, not.
  * `resolved` (may be NULL) receives the geometry as used. */
 int mf_scene_build(const mf_dict *geometry, double l0_override, mf_sim *sim, mf_dict *resolved);
+/* The same, reading the polygon files of `type mesh` entries (fluidBlocks,
+ * walls, obstacles: mf_trimesh.h) with `reader` (the driver passes io's,
+ * mf_mesh_import.h). mf_scene_build is this with no reader: a mesh entry is
+ * then an error. */
+struct mf_trimesh_reader;
+int mf_scene_build_with_reader(const mf_dict *geometry, double l0_override, mf_sim *sim,
+                               mf_dict *resolved, const struct mf_trimesh_reader *reader);
 
 /* Refuse particles closer than l0/2 (overlapping blocks, a block inside a
  * wall), naming the first pair. */

@@ -16,6 +16,9 @@
 #include "mf_registry.h"
 
 #define MF_MAX_FLUIDS 16
+#define MF_MAX_SCALARS 8
+
+struct mf_emitters; /* mf_emitter.h */
 
 typedef struct mf_fluid {
     char name[64];
@@ -74,6 +77,14 @@ typedef struct mf_sim {
     /* Statistics the driver reports (filled by modules). */
     double courant_mean, courant_max;
     long pressure_iterations;  /* summed over the run */
+    /* Transported scalars ("dye", "temperature"): optional particle fields of
+     * these names, declared by the case (mf_emitter.h); a solver that convects
+     * (MPS-MAFL) carries each. */
+    int nscalars;
+    char scalar_name[MF_MAX_SCALARS][32];
+    /* Inlets, outlets and nozzles (mf_emitter.h), applied by the time loop
+     * before each step; NULL when the case has none. */
+    struct mf_emitters *emitters;
 } mf_sim;
 
 #endif

@@ -6,8 +6,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_emitter.h"
 #include "mf_error.h"
 #include "mf_params.h"
+#include "mf_trimesh.h"
 
 /* ---- fluids -------------------------------------------------------------- */
 typedef struct fluid_settings {
@@ -78,6 +80,8 @@ typedef struct geometry_settings {
     long dimension;
     double spacing;
     const mf_dict *fluid_blocks, *walls;
+    const mf_dict *inlets, *outlets, *emitters; /* mf_emitter.h */
+    const mf_dict *obstacles;                   /* mf_trimesh.h */
 } geometry_settings;
 
 static const mf_param geometry_params[] = {
@@ -89,28 +93,61 @@ static const mf_param geometry_params[] = {
      offsetof(geometry_settings, fluid_blocks), "named blocks of fluid particles"},
     {"walls", MF_PARAM_DICT, NULL, MF_NO_RANGE, NULL, offsetof(geometry_settings, walls),
      "named walls (layers of fixed particles)"},
+    {"inlets", MF_PARAM_DICT, NULL, MF_NO_RANGE, NULL, offsetof(geometry_settings, inlets),
+     "named inlets: buffers of points with a given velocity (mf_emitter.h)"},
+    {"outlets", MF_PARAM_DICT, NULL, MF_NO_RANGE, NULL, offsetof(geometry_settings, outlets),
+     "named outlets: buffers where fluid leaves and is removed"},
+    {"emitters", MF_PARAM_DICT, NULL, MF_NO_RANGE, NULL, offsetof(geometry_settings, emitters),
+     "named emitters (type nozzle): add fluid at a velocity and rate for a time window"},
+    {"obstacles", MF_PARAM_DICT, NULL, MF_NO_RANGE, NULL, offsetof(geometry_settings, obstacles),
+     "named solid bodies in the fluid (type mesh: a polygon file, mf_trimesh.h)"},
 };
 static const char *const geometry_extra[] = {"FoamFile", NULL};
 
-static const char *const block_types[] = {"box", NULL};
+static const char *const block_types[] = {"box", "mesh", NULL}; /* mesh: mf_trimesh.h */
+
+/* Fluid blocks: a box (min, max) or a sphere, a disk in 2-D (centre,
+ * radius; for droplets). */
+static const char *const fluid_block_types[] = {"box", "sphere", "mesh", NULL};
 
 typedef struct block_settings {
     const char *type;
     double min[3], max[3], velocity[3];
     const char *fluid;
+    const mf_dict *scalars;
+    double centre[3], radius;
+    bool overwrite;
+    double wave_amplitude, wave_length;
 } block_settings;
+#define BLOCK_NPARAMS 11
 
-static const mf_param block_params[] = {
-    {"type", MF_PARAM_WORD, "box", MF_NO_RANGE, block_types, offsetof(block_settings, type),
-     "shape of the block"},
-    {"min", MF_PARAM_VECTOR, NULL, MF_NO_RANGE, NULL, offsetof(block_settings, min),
-     "lower corner, m"},
-    {"max", MF_PARAM_VECTOR, NULL, MF_NO_RANGE, NULL, offsetof(block_settings, max),
-     "upper corner, m"},
+static const mf_param block_params[BLOCK_NPARAMS] = {
+    {"type", MF_PARAM_WORD, "box", MF_NO_RANGE, fluid_block_types,
+     offsetof(block_settings, type), "shape of the block: box (min, max) or sphere (centre, "
+     "radius; a disk in 2-D)"},
+    {"min", MF_PARAM_VECTOR, "(0 0 0)", MF_NO_RANGE, NULL, offsetof(block_settings, min),
+     "lower corner, m (box; required)"},
+    {"max", MF_PARAM_VECTOR, "(0 0 0)", MF_NO_RANGE, NULL, offsetof(block_settings, max),
+     "upper corner, m (box; required)"},
     {"velocity", MF_PARAM_VECTOR, "(0 0 0)", MF_NO_RANGE, NULL,
      offsetof(block_settings, velocity), "initial velocity, m/s"},
     {"fluid", MF_PARAM_WORD, NULL, MF_NO_RANGE, NULL, offsetof(block_settings, fluid),
      "name of a fluid in constant/fluids"},
+    {"scalars", MF_PARAM_DICT, NULL, MF_NO_RANGE, NULL, offsetof(block_settings, scalars),
+     "initial transported scalars: { dye { type gaussian; ... } tracer 0; } (mf_emitter.h)"},
+    {"centre", MF_PARAM_VECTOR, "(0 0 0)", MF_NO_RANGE, NULL, offsetof(block_settings, centre),
+     "centre, m (sphere)"},
+    {"radius", MF_PARAM_SCALAR, "0", 0, 1e9, NULL, offsetof(block_settings, radius),
+     "radius, m (sphere; required)"},
+    {"overwrite", MF_PARAM_BOOL, "no", MF_NO_RANGE, NULL, offsetof(block_settings, overwrite),
+     "remove the fluid particles of earlier blocks inside this one first (a droplet in "
+     "another fluid; as setFields regions overwrite)"},
+    {"topAmplitude", MF_PARAM_SCALAR, "0", -1e9, 1e9, NULL,
+     offsetof(block_settings, wave_amplitude),
+     "box: the top face is y = max_y + topAmplitude sin(2 pi (x - min_x) / topWavelength), m "
+     "(a perturbed interface: Rayleigh-Taylor)"},
+    {"topWavelength", MF_PARAM_SCALAR, "1", 1e-12, 1e12, NULL,
+     offsetof(block_settings, wave_length), "wavelength of the top face's wave, m"},
 };
 
 typedef struct wall_settings {
@@ -152,13 +189,74 @@ static int check_box(const char *what, const char *name, const mf_dict *d, const
     return 0;
 }
 
+/* A box needs min and max, a sphere its radius. */
+static int check_block_shape(const char *name, const mf_dict *d, bool sphere,
+                             const block_settings *s, int dim)
+{
+    char where[512];
+    if (sphere) {
+        if (!(s->radius > 0))
+            return MF_ERROR(MF_ERR_INPUT,
+                            "%s: fluid block '%s': type sphere needs a radius > 0 (and a centre)",
+                            mf_loc_str(d->loc, where, sizeof where), name);
+        return 0;
+    }
+    if (!mf_dict_find(d, "min") || !mf_dict_find(d, "max"))
+        return MF_ERROR(MF_ERR_INPUT, "%s: fluid block '%s': type box needs 'min' and 'max'",
+                        mf_loc_str(d->loc, where, sizeof where), name);
+    return check_box("fluid block", name, d, s->min, s->max, dim);
+}
+
+/* The height of a box block's top face at x (a wave when topAmplitude != 0). */
+static double box_top(const block_settings *s, const double x[3])
+{
+    return s->max[1] + s->wave_amplitude * sin(2 * M_PI * (x[0] - s->min[0]) / s->wave_length);
+}
+
+static bool inside_sphere(const double x[3], const double c[3], double r, int dim)
+{
+    double d2 = 0;
+    for (int a = 0; a < dim; a++)
+        d2 += (x[a] - c[a]) * (x[a] - c[a]);
+    return d2 < r * r;
+}
+
+/* overwrite: the fluid particles already placed inside the block's shape go
+ * (the test that places the block's own particles, so that blocks on the
+ * same lattice fit without gap or overlap). */
+static int remove_fluid_inside(mf_sim *sim, const block_settings *s, bool sphere)
+{
+    mf_particles *p = sim->p;
+    uint8_t *gone = calloc(p->n ? p->n : 1, 1);
+    if (!gone)
+        return MF_ERROR(MF_ERR_MEMORY, "out of memory");
+    for (size_t i = 0; i < p->n; i++) {
+        if (p->kind[i] != MF_FLUID)
+            continue;
+        const double *x = &p->pos[3 * i];
+        bool in = true;
+        if (sphere) {
+            in = inside_sphere(x, s->centre, s->radius, sim->dim);
+        } else {
+            for (int a = 0; a < sim->dim; a++)
+                in = in && x[a] > s->min[a] && (a == 1 ? x[a] < box_top(s, x) : x[a] < s->max[a]);
+        }
+        gone[i] = in;
+    }
+    size_t removed = 0;
+    int rc = mf_particles_remove(p, gone, &removed);
+    free(gone);
+    return rc;
+}
+
 static int add_fluid_block(mf_sim *sim, const char *name, const mf_dict *d, int fluid_field,
                            mf_dict *resolved)
 {
     block_settings s;
     mf_dict *out = resolved ? mf_dict_set_subdict(resolved, name) : NULL;
-    MF_CALL(mf_params_apply(block_params, 5, d, NULL, &s, out));
-    MF_CALL(check_box("fluid block", name, d, s.min, s.max, sim->dim));
+    MF_CALL(mf_params_apply(block_params, BLOCK_NPARAMS, d, NULL, &s, out));
+    const bool sphere = strcmp(s.type, "sphere") == 0;
+    MF_CALL(check_block_shape(name, d, sphere, &s, sim->dim));
     int fid = 0;
     if (mf_scene_fluid_index(sim, s.fluid, &fid) != 0) {
         char where[512];
@@ -168,14 +266,27 @@ static int add_fluid_block(mf_sim *sim, const char *name, const mf_dict *d, int 
     }
     const double l0 = sim->l0;
     long lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
-    for (int a = 0; a < sim->dim; a++)
-        hi[a] = lattice_count(s.min[a], s.max[a], l0);
+    if (sphere) { /* the lattice centre + (i + 1/2) l0, symmetric about the centre */
+        long m = (long)ceil(s.radius / l0);
+        for (int a = 0; a < sim->dim; a++) {
+            s.min[a] = s.centre[a] - (double)m * l0;
+            hi[a] = 2 * m;
+        }
+    }
+    for (int a = 0; a < sim->dim && !sphere; a++)
+        hi[a] = lattice_count(s.min[a], s.max[a] + (a == 1 ? fabs(s.wave_amplitude) : 0), l0);
+    if (s.overwrite)
+        MF_CALL(remove_fluid_inside(sim, &s, sphere));
     size_t before = sim->p->n;
     for (long k = lo[2]; k < hi[2]; k++)
         for (long j = lo[1]; j < hi[1]; j++)
             for (long i = lo[0]; i < hi[0]; i++) {
                 double x[3] = {s.min[0] + (i + 0.5) * l0, s.min[1] + (j + 0.5) * l0,
                                sim->dim == 3 ? s.min[2] + (k + 0.5) * l0 : 0.0};
+                if (sphere && !inside_sphere(x, s.centre, s.radius, sim->dim))
+                    continue;
+                if (!sphere && s.wave_amplitude != 0 && !(x[1] < box_top(&s, x)))
+                    continue;
                 MF_CALL(mf_particles_add(sim->p, MF_FLUID, x, s.velocity, NULL));
             }
     if (fluid_field >= 0) {
@@ -183,6 +294,9 @@ static int add_fluid_block(mf_sim *sim, const char *name, const mf_dict *d, int 
         for (size_t i = before; i < sim->p->n; i++)
             fid_arr[i] = fid;
     }
+    if (s.scalars)
+        MF_CALL(mf_scene_block_scalars(sim, s.scalars, before, sim->p->n,
+                                       out ? mf_dict_set_subdict(out, "scalars") : NULL));
     if (sim->p->n == before) {
         char where[512];
         return MF_ERROR(MF_ERR_INPUT,
@@ -301,43 +415,90 @@ static int for_each_named(const mf_dict *group, const char *what,
 typedef struct build_ctx {
     int fluid_field;
     mf_dict *resolved;
+    mf_scene_meshes *meshes; /* type mesh entries, read up front (mf_trimesh.h) */
 } build_ctx;
 
 static int visit_block(mf_sim *sim, const char *name, const mf_dict *d, void *ctx)
 {
     build_ctx *c = ctx;
+    if (mf_scene_entry_is_mesh(d))
+        return mf_scene_mesh_fluid(c->meshes, sim, name, d, c->fluid_field,
+                                   c->resolved ? mf_dict_set_subdict(c->resolved, name) : NULL);
     return add_fluid_block(sim, name, d, c->fluid_field, c->resolved);
 }
 
 static int visit_wall(mf_sim *sim, const char *name, const mf_dict *d, void *ctx)
 {
     build_ctx *c = ctx;
+    if (mf_scene_entry_is_mesh(d))
+        return mf_scene_mesh_wall(c->meshes, sim, name, d, false,
+                                  c->resolved ? mf_dict_set_subdict(c->resolved, name) : NULL);
     return add_wall_box(sim, name, d, c->resolved);
 }
 
+static int visit_obstacle(mf_sim *sim, const char *name, const mf_dict *d, void *ctx)
+{
+    build_ctx *c = ctx;
+    if (!mf_scene_entry_is_mesh(d)) {
+        char where[512];
+        return MF_ERROR(MF_ERR_INPUT, "%s: obstacle '%s': obstacles are `type mesh;` (a polygon "
+                        "file); a box of walls goes in walls", mf_loc_str(d->loc, where,
+                        sizeof where), name);
+    }
+    return mf_scene_mesh_wall(c->meshes, sim, name, d, true,
+                              c->resolved ? mf_dict_set_subdict(c->resolved, name) : NULL);
+}
+
+static int build_scene(const mf_dict *geometry, double l0_override, mf_sim *sim,
+                       mf_dict *resolved, const mf_trimesh_reader *reader, build_ctx *ctx);
+
 int mf_scene_build(const mf_dict *geometry, double l0_override, mf_sim *sim, mf_dict *resolved)
 {
+    return mf_scene_build_with_reader(geometry, l0_override, sim, resolved, NULL);
+}
+
+int mf_scene_build_with_reader(const mf_dict *geometry, double l0_override, mf_sim *sim,
+                               mf_dict *resolved, const mf_trimesh_reader *reader)
+{
+    build_ctx ctx = {-1, NULL, NULL};
+    int rc = build_scene(geometry, l0_override, sim, resolved, reader, &ctx);
+    mf_scene_meshes_destroy(ctx.meshes);
+    return rc;
+}
+
+static int build_scene(const mf_dict *geometry, double l0_override, mf_sim *sim,
+                       mf_dict *resolved, const mf_trimesh_reader *reader, build_ctx *ctx)
+{
     geometry_settings g;
-    MF_CALL(mf_params_apply(geometry_params, 4, geometry, geometry_extra, &g, NULL));
+    MF_CALL(mf_params_apply(geometry_params, 8, geometry, geometry_extra, &g, NULL));
     sim->dim = (int)g.dimension;
     sim->l0 = l0_override > 0 ? l0_override : g.spacing;
     if (resolved) {
         MF_CALL(mf_dict_set_number(resolved, "dimension", (double)sim->dim));
         MF_CALL(mf_dict_set_number(resolved, "particleSpacing", sim->l0));
     }
-    if (!g.fluid_blocks && !g.walls) {
+    if (!g.fluid_blocks && !g.walls && !g.obstacles) {
         char where[512];
         return MF_ERROR(MF_ERR_INPUT, "%s: the geometry has neither fluidBlocks nor walls",
                         mf_loc_str(geometry->loc, where, sizeof where));
     }
+    MF_CALL(mf_scene_meshes_create(geometry, reader, sim->dim, sim->l0, sim->log, &ctx->meshes));
     MF_CALL(mf_particles_create(sim->dim, 1024, &sim->p));
-    build_ctx ctx = {-1, NULL};
     if (sim->nfluids > 1)
         MF_CALL(mf_particles_request_field(sim->p, "FluidId", 1, MF_FIELD_INT32, true,
-                                           &ctx.fluid_field));
-    ctx.resolved = resolved ? mf_dict_set_subdict(resolved, "fluidBlocks") : NULL;
-    MF_CALL(for_each_named(g.fluid_blocks, "fluid block", visit_block, sim, &ctx));
-    ctx.resolved = resolved ? mf_dict_set_subdict(resolved, "walls") : NULL;
-    MF_CALL(for_each_named(g.walls, "wall", visit_wall, sim, &ctx));
+                                           &ctx->fluid_field));
+    ctx->resolved = resolved ? mf_dict_set_subdict(resolved, "fluidBlocks") : NULL;
+    MF_CALL(for_each_named(g.fluid_blocks, "fluid block", visit_block, sim, ctx));
+    ctx->resolved = resolved ? mf_dict_set_subdict(resolved, "walls") : NULL;
+    MF_CALL(for_each_named(g.walls, "wall", visit_wall, sim, ctx));
+    ctx->resolved = resolved && g.obstacles ? mf_dict_set_subdict(resolved, "obstacles") : NULL;
+    MF_CALL(for_each_named(g.obstacles, "obstacle", visit_obstacle, sim, ctx));
+    MF_CALL(mf_emitters_create(sim, g.inlets, g.outlets, g.emitters,
+                               resolved && g.inlets ? mf_dict_set_subdict(resolved, "inlets") : NULL,
+                               resolved && g.outlets ? mf_dict_set_subdict(resolved, "outlets")
+                                                     : NULL,
+                               resolved && g.emitters ? mf_dict_set_subdict(resolved, "emitters")
+                                                      : NULL,
+                               &sim->emitters));
     return 0;
 }

@@ -27,6 +27,8 @@ static void usage(FILE *f)
             "                    against run time (-solvers '(A B)' -resolutions '(l0 ...)')\n"
             "  stability         sweep system/stabilityDict's parameters for each scheme and\n"
             "                    map stable and unstable runs (-solvers '(A B)' [-sweeps '(...)'])\n"
+            "  surface           reconstruct the free surface of the snapshots as meshes\n"
+            "                    (-time T | -latestTime, -method levelSet|blobby; surface -help)\n"
             "\n"
             "Options:\n"
             "  -case DIR         case directory (default: the current folder)\n"
@@ -45,6 +47,8 @@ static void usage(FILE *f)
             "Plugins are searched as named, then in MPSFLOW_PLUGIN_PATH, then in the\n"
             "plugins folder beside the executable's build or install tree.\n");
 }
+
+int mf_main_surface(int argc, char **argv, int first); /* surface.c: its own options */
 
 static int parse_number(const char *opt, const char *text, double *out)
 {
@@ -199,6 +203,8 @@ int main(int argc, char **argv)
         command = argv[1];
         first = 2;
     }
+    if (command && !strcmp(command, "surface"))
+        return mf_main_surface(argc, argv, first);
     const char *module_name = NULL;
     if (command && !strcmp(command, "modules") && argc > 2 && argv[2][0] != '-') {
         module_name = argv[2];

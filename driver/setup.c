@@ -4,7 +4,9 @@
 
 #include "mf_app.h"
 #include "mf_dictio.h"
+#include "mf_emitter.h"
 #include "mf_error.h"
+#include "mf_mesh_import.h"
 #include "mf_scene.h"
 
 int mf_app_load_libs_text(mf_registry *reg, const char *text)
@@ -201,8 +203,9 @@ int mf_app_setup(mf_app *app)
     sim->fixed_dt = !c->adjust_time_step;
     MF_CALL(mf_scene_read_fluids(app->cs.fluids, sim));
     mf_dict *resolved = app->cs.resolved;
-    MF_CALL(mf_scene_build(app->cs.geometry, app->opt.l0, sim,
-                           mf_dict_set_subdict(resolved, "geometry")));
+    const mf_trimesh_reader mesh_reader = mf_mesh_import_reader(); /* polygon files */
+    MF_CALL(mf_scene_build_with_reader(app->cs.geometry, app->opt.l0, sim,
+                                       mf_dict_set_subdict(resolved, "geometry"), &mesh_reader));
     MF_CALL(mf_scene_check_overlap(sim));
     mf_dict *rf = mf_dict_set_subdict(resolved, "fluids");
     for (int k = 0; k < sim->nfluids; k++) {
@@ -265,6 +268,8 @@ void mf_app_teardown(mf_app *app)
     free(app->sim.forces);
     free(app->sim.wall_boxes);
     mf_watch_free(&app->run.watch);
+    mf_emitters_destroy(app->sim.emitters);
+    app->sim.emitters = NULL;
     mf_particles_destroy(app->sim.p);
     mf_case_free(&app->cs);
 }
@@ -283,6 +288,12 @@ void mf_app_summary(const mf_app *app)
     for (int k = 0; k < sim->nfluids; k++)
         printf("    %-12s rho = %g kg/m^3, nu = %g m^2/s, sigma = %g N/m\n", sim->fluid[k].name,
                sim->fluid[k].rho, sim->fluid[k].nu, sim->fluid[k].sigma);
+    const mf_emitters *em = sim->emitters;
+    if (em)
+        printf("Emitters: %zu inlet(s), %zu outlet(s), %zu nozzle(s)\n", em->ninlets,
+               em->noutlets, em->nnozzles);
+    for (int k = 0; k < sim->nscalars; k++)
+        printf("Transported scalar: %s\n", sim->scalar_name[k]);
     printf("Solver %s; time %g to %g s\n", app->solver.info->name, sim->time, sim->end_time);
     printf("Memory: particles %.2f MB; peak resident %.1f MB\n",
            mf_particles_memory(sim->p) / 1048576.0, mf_peak_memory() / 1048576.0);

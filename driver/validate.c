@@ -9,9 +9,23 @@
 #include "mf_error.h"
 #include "mf_post.h"
 
+extern const mf_metric mf_metric_scalar_advection; /* metric_scalar.c */
+extern const mf_metric mf_metric_volume_flux;      /* metric_scalar.c */
+
+/* metric_droplet.c: the multi-fluid cases */
+extern const mf_metric mf_metric_laplace, mf_metric_oscillation, mf_metric_layering,
+    mf_metric_rayleigh_taylor, mf_metric_fluid_surge_front;
+
 static const mf_metric *const metrics[] = {
     &mf_metric_surge_front,
     &mf_metric_hydrostatic,
+    &mf_metric_scalar_advection,
+    &mf_metric_volume_flux,
+    &mf_metric_laplace,
+    &mf_metric_oscillation,
+    &mf_metric_layering,
+    &mf_metric_rayleigh_taylor,
+    &mf_metric_fluid_surge_front,
 };
 #define NMETRICS (sizeof metrics / sizeof metrics[0])
 
@@ -95,7 +109,8 @@ int mf_cmd_validate(const char *case_dir, double *error)
             names[k] = metrics[k]->name;
         const char *hint = mf_did_you_mean(name, names, NMETRICS);
         rc = MF_ERROR(MF_ERR_INPUT, "%s: unknown metric '%s'%s%s%s; known: surgeFront, "
-                      "hydrostaticPressure",
+                      "hydrostaticPressure, scalarAdvection, volumeFlux, laplacePressure, "
+                      "oscillationPeriod, layering, rayleighTaylor, fluidSurgeFront",
                       path, name, hint ? " (did you mean '" : "", hint ? hint : "",
                       hint ? "'?)" : "");
     }

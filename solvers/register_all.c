@@ -2,8 +2,12 @@
 #include "mf_error.h"
 #include "mf_solvers.h"
 
+#include "convection/convection.h"
 #include "forces/forces.h"
+#include "levelset/levelset.h"
+#include "mafl/mafl.h"
 #include "mps/mps.h"
+#include "multifluid/multifluid.h"
 #include "pressure/pressure_hypre.h"
 
 int mf_solvers_register_all(mf_registry *reg)
@@ -13,6 +17,15 @@ int mf_solvers_register_all(mf_registry *reg)
         &mf_pressure_PCG_BoomerAMG.info,
         &mf_pressure_PCG_diagonal.info,
         &mf_force_gravity.info,
+        &mf_surface_levelSet.info,
+        &mf_surface_blobby.info,
+        &mf_function_surface.info,
+        &mf_solver_multiFluid.info,
+        &mf_force_surfaceTension.info,
+        &mf_force_drag.info,
+        &mf_solver_MAFL.info,
+        &mf_convection_upwind.info,
+        &mf_convection_QUICK.info,
     };
     for (size_t k = 0; k < sizeof modules / sizeof modules[0]; k++)
         MF_CALL(mf_registry_add(reg, modules[k]));

@@ -8,8 +8,10 @@
  * plus files for a phase big enough to stand alone (here mps_ppe.c).
  *
  * Other solvers compose this one: MPS-MAFL calls mps_lagrangian_step for
- * its Lagrangian phase; the multi-fluid solver reuses the PPE assembly with
- * a per-pair density.
+ * its Lagrangian phase; the multi-fluid solver reuses the phases, the PPE
+ * assembly and the correction with a density and a viscosity per particle
+ * and a pair average (the `Multi-fluid` fields of mps_data). Left NULL,
+ * those fields keep the single-fluid path, bit for bit.
  */
 #ifndef MPS_H
 #define MPS_H
@@ -36,6 +38,27 @@ typedef struct mps_settings {
     long reorder_interval;    /* sort particles along cells every N steps (0: never) */
 } mps_settings;
 
+/* Pair averages (eq. 27 with unlike neighbours; the variable-density PPE).
+ * Density: 1/rho_ij = 1/rho_bar_ij with rho_bar the arithmetic mean
+ * (rho_i + rho_j)/2 (the default: the series coefficient of a flux across
+ * an interface, as a finite-volume face would take it) or the harmonic
+ * mean 2 rho_i rho_j/(rho_i + rho_j), i.e. 1/rho_ij = (1/rho_i + 1/rho_j)/2.
+ * Viscosity: mu_ij harmonic (default) or arithmetic mean of mu = rho nu. */
+typedef enum { MPS_AVERAGE_ARITHMETIC = 0, MPS_AVERAGE_HARMONIC = 1 } mps_average;
+
+static inline double mps_inv_rho_pair(double rho_i, double rho_j, int average)
+{
+    return average == MPS_AVERAGE_HARMONIC ? 0.5 * (1.0 / rho_i + 1.0 / rho_j)
+                                           : 2.0 / (rho_i + rho_j);
+}
+
+static inline double mps_mu_pair(double mu_i, double mu_j, int average)
+{
+    if (average == MPS_AVERAGE_ARITHMETIC)
+        return 0.5 * (mu_i + mu_j);
+    return mu_i + mu_j > 0.0 ? 2.0 * mu_i * mu_j / (mu_i + mu_j) : 0.0;
+}
+
 typedef struct mps_data {
     mps_settings s;
     mf_kernel k_nd, k_grad, k_lap; /* one kernel per operator radius */
@@ -60,6 +83,19 @@ typedef struct mps_data {
     long ppe_rows;
     double t_neighbours, t_explicit, t_assembly, t_solve, t_correction;
     double t_setup, t_pcg; /* parts of t_solve, as the pressure module reports them */
+    /* Multi-fluid, set by a composing solver after mps_create_data (all NULL
+     * for one fluid: the single-fluid path, unchanged). Arrays have one entry
+     * per particle (walls included) and follow the current particle order. */
+    const double *rho;         /* density; NULL: sim->fluid[0].rho */
+    const double *mu;          /* dynamic viscosity of fluids; NULL: sim->fluid[0].nu */
+    int rho_average, mu_average; /* mps_average of each pair */
+    /* PPE: the pressure of particles that are not unknowns but take part
+     * (non-dummy neighbours: free surface, or held by another solve); NULL: 0. */
+    const double *p_dirichlet;
+    const char *solve_name;    /* the log's "Solving for <name>"; NULL: p */
+    /* PPE source against a per-particle reference: rhs ~ (n*_i - n0 - n_offset_i)/n0
+     * (MPS-MAFL's densityReference startOfStep); NULL: none. */
+    const double *n_offset;
 } mps_data;
 
 enum { MPS_FLAG_SURFACE = 1 }; /* bits of the Flags field */
@@ -67,6 +103,42 @@ enum { MPS_FLAG_SURFACE = 1 }; /* bits of the Flags field */
 extern const mf_solver_ops mf_solver_MPS;
 #define MPS_NPARAMS 12 /* checked against the table in mps_params.c */
 extern const mf_param mps_params[MPS_NPARAMS];
+/* The entries of that table, for a solver whose settings embed an
+ * mps_settings (the multi-fluid solver): OFF(field) is the offset of the
+ * embedded field in the embedding struct. One list, two tables.
+ * reNumberDensity 3.1 rather than Koshizuka & Oka's 2.1: on hydrostatic2D
+ * the resting pressure comes out 7.5% high at the bottom with 2.1 and within
+ * 1% with 3.1 (README, "Choices measured"). */
+#define MPS_PARAM_ENTRIES(OFF)                                                                  \
+    {"reNumberDensity", MF_PARAM_SCALAR, "3.1", 1.01, 10, NULL,                                 \
+     OFF(re_number_density),                                                                    \
+     "radius of the number density (source term, surface), in l0"},                             \
+    {"reGradient", MF_PARAM_SCALAR, "2.1", 1.01, 10, NULL, OFF(re_gradient),                    \
+     "radius of the pressure gradient, in l0"},                                                 \
+    {"reLaplacian", MF_PARAM_SCALAR, "3.1", 1.01, 10, NULL, OFF(re_laplacian),                  \
+     "radius of the Laplacian (viscosity, pressure equation), in l0"},                          \
+    {"beta", MF_PARAM_SCALAR, "0.97", 0.5, 1.0, NULL, OFF(beta),                                \
+     "free surface where n* < beta n0 (eq. 18)"},                                               \
+    {"relaxation", MF_PARAM_SCALAR, "1", 0.01, 1, NULL, OFF(relaxation),                        \
+     "factor on the source term of the pressure equation (1: the paper)"},                      \
+    {"compressibility", MF_PARAM_SCALAR, "0", 0, 1e-3, NULL,                                    \
+     OFF(compressibility),                                                                      \
+     "artificial compressibility, 1/Pa (adds rho c/dt^2 to the diagonal; 0: off)"},             \
+    {"clipNegativePressure", MF_PARAM_BOOL, "yes", MF_NO_RANGE, NULL,                           \
+     OFF(clip_negative_pressure), "set negative pressures to zero"},                            \
+    {"gradientPmin", MF_PARAM_BOOL, "yes", MF_NO_RANGE, NULL,                                   \
+     OFF(gradient_pmin),                                                                        \
+     "pressure gradient with p_min of the neighbourhood (eq. 5 note)"},                         \
+    {"collision", MF_PARAM_BOOL, "no", MF_NO_RANGE, NULL, OFF(collision),                       \
+     "push apart particles closer than collisionDistance (not in the paper)"},                  \
+    {"collisionDistance", MF_PARAM_SCALAR, "0.5", 0.1, 1, NULL,                                 \
+     OFF(collision_distance), "collision distance, in l0"},                                     \
+    {"restitution", MF_PARAM_SCALAR, "0.2", 0, 1, NULL, OFF(restitution),                       \
+     "coefficient of restitution of the collision model"},                                      \
+    {"reorderInterval", MF_PARAM_INT, "25", 0, 1000000, NULL,                                   \
+     OFF(reorder_interval),                                                                     \
+     "sort particles along cells every N steps for memory locality (0: never)"},                \
+
 
 /* mps_module.c */
 int mps_create_data(const mps_settings *s, mf_sim *sim, const mf_dict *solver_dict,
@@ -78,7 +150,10 @@ int mps_reserve(mps_data *d, size_t n);
 /* Grid and lists at the current positions; with reorder, particles are
  * first sorted along cells every reorder_interval steps. */
 int mps_build_neighbours(mps_data *d, mf_sim *sim, bool reorder);
-int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt);     /* eqs. 9-10 */
+void mps_set_masks(mps_data *d, const mf_particles *p);          /* is_fluid, not_dummy */
+int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt);     /* eqs. 9-10 (27) */
+/* eq. 18: number density at r*, free surface, PPE unknowns (in_ppe). */
+int mps_surface_phase(mps_data *d, mf_sim *sim);
 int mps_pressure_phase(mps_data *d, mf_sim *sim, double dt);     /* eqs. 11-14, 18 */
 int mps_correction_phase(mps_data *d, mf_sim *sim, double dt);   /* eqs. 15-17 */
 /* The whole Lagrangian step, as MPS-MAFL calls it. */
@@ -87,5 +162,20 @@ int mps_lagrangian_step(mps_data *d, mf_sim *sim, double dt);
 /* mps_ppe.c */
 int mps_assemble_ppe(mps_data *d, const mf_sim *sim, double dt);
 int mps_solve_ppe(mps_data *d, mf_sim *sim);
+
+/* mps_pairs.c: the operators with a per-pair coefficient (multi-fluid). */
+/* eq. 27's viscous term: acc_i += 2d/(lambda n0) (1/rho_i) sum_j mu_ij (u_j - u_i) w_ij
+ * for fluid i (walls and dummies: u = 0, mu_ij = mu_i). */
+void mps_viscous_pairs(const mps_data *d, const mf_particles *p, const mf_nlist *nl,
+                       double *acc);
+/* eq. 15 with 1/rho_ij: grad_i = d/n0 sum_j (1/rho_ij) (p_j - p^_i) r_ij/|r_ij|^2 w_ij
+ * (the pressure acceleration, already divided by the density), p^_i = p_i or
+ * the neighbourhood minimum (gradientPmin), into d->grad for the fluid
+ * particles with imask set (NULL: all fluid); p of non-dummy neighbours. */
+void mps_gradient_pairs(mps_data *d, const mf_particles *p, const double *pressure,
+                        const uint8_t *imask);
+/* eqs. 16-17 for those particles: u' = -dt grad, u += u', r += dt u'.
+ * Returns max |u'|. */
+double mps_apply_correction(mps_data *d, mf_particles *p, double dt, const uint8_t *imask);
 
 #endif

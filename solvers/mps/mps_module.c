@@ -2,6 +2,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "forces/forces.h"
 #include "mf_error.h"
 #include "mps.h"
 
@@ -100,6 +101,12 @@ void mps_destroy_data(mps_data *d)
 
 static int mps_create(const void *settings, mf_sim *sim, const mf_dict *solver_dict, void **data)
 {
+    if (sim->nfluids > 1)
+        return MF_ERROR(MF_ERR_INPUT,
+                        "solver MPS models one fluid, but constant/fluids defines %d (%s, %s%s): "
+                        "use solver multiFluid",
+                        sim->nfluids, sim->fluid[0].name, sim->fluid[1].name,
+                        sim->nfluids > 2 ? ", ..." : "");
     mps_data *d = NULL;
     int rc = mps_create_data(settings, sim, solver_dict, &d);
     if (rc != 0) {
@@ -117,6 +124,14 @@ static int mps_step(void *data, mf_sim *sim, double dt)
 }
 
 static void mps_destroy(void *data) { mps_destroy_data(data); }
+
+/* The forces' own limit (the capillary step of surfaceTension), if any. */
+static int mps_stable_dt(void *data, const mf_sim *sim, double *dt)
+{
+    (void)data;
+    *dt = mf_forces_stable_dt(sim);
+    return 0;
+}
 
 static void mps_report(void *data, const mf_sim *sim, mf_log *log)
 {
@@ -145,6 +160,6 @@ const mf_solver_ops mf_solver_MPS = {
     .create = mps_create,
     .step = mps_step,
     .destroy = mps_destroy,
-    .stable_dt = NULL,
+    .stable_dt = mps_stable_dt,
     .report = mps_report,
 };

@@ -9,6 +9,15 @@
  * A group of unknowns with no Dirichlet neighbour anywhere (a closed box
  * filled to the lid) makes A singular; its diagonal is doubled there, as the
  * Koshizuka lab's codes do, and the log says so at verbose level.
+ *
+ * With a density per particle (mps_data.rho, the multi-fluid solver) the
+ * equation is div((1/rho) grad p) = (1/dt^2)(n* - n0)/n0, discretised as
+ *   A_ii = c sum_j w_ij / rho_ij,  A_ij = -c w_ij / rho_ij,
+ *   rhs_i = relaxation (1/dt^2) (n*_i - n0)/n0,
+ * still symmetric since 1/rho_ij is a symmetric pair average
+ * (mps_inv_rho_pair). Non-unknown neighbours with a given pressure
+ * (mps_data.p_dirichlet: the light fluid's pressure held on the heavy fluid's
+ * interface) move c w_ij p_j / rho_ij to the right-hand side.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -105,6 +114,8 @@ int mps_assemble_ppe(mps_data *d, const mf_sim *sim, double dt)
     A->nglobal = (int64_t)nrows; /* one rank */
     const double c = 2.0 * d->k_lap.dim / (d->k_lap.lambda * d->k_lap.n0);
     const double rho = sim->fluid[0].rho, n0 = d->k_nd.n0, re = nl->radius;
+    const double *rho_p = d->rho, *pd = d->p_dirichlet;
+    const int avg = d->rho_average;
     const double *pressure = mf_particles_fd(p, d->f_pressure);
     size_t pos = 0;
     for (size_t i = 0; i < p->n_owned; i++) {
@@ -114,7 +125,7 @@ int mps_assemble_ppe(mps_data *d, const mf_sim *sim, double dt)
         A->rowptr[r] = pos;
         size_t diag = pos++;
         A->col[diag] = A->row_offset + (int64_t)r;
-        double sum = 0;
+        double sum = 0, known = 0;
         for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
             size_t j = nl->j[k];
             if (!d->not_dummy[j])
@@ -122,18 +133,32 @@ int mps_assemble_ppe(mps_data *d, const mf_sim *sim, double dt)
             double dx = p->pos[3 * j] - p->pos[3 * i], dy = p->pos[3 * j + 1] - p->pos[3 * i + 1],
                    dz = p->pos[3 * j + 2] - p->pos[3 * i + 2];
             double w = mf_weight(sqrt(dx * dx + dy * dy + dz * dz), re);
-            sum += c * w;
+            double cw = c * w;
+            if (rho_p)
+                cw *= mps_inv_rho_pair(rho_p[i], rho_p[j], avg);
+            sum += cw;
             if (d->in_ppe[j]) {
                 A->col[pos] = A->row_offset + d->row[j];
-                A->val[pos++] = -c * w;
+                A->val[pos++] = -cw;
             } else if (w > 0) {
                 touches[r] = 1; /* a Dirichlet neighbour */
+                if (pd)
+                    known += cw * pd[j];
             }
         }
-        A->val[diag] = sum + d->s.compressibility * rho / (dt * dt);
+        /* n* - n0, or against a per-particle reference (mps_data.n_offset) */
+        const double dn = d->n_offset ? n[i] - n0 - d->n_offset[i] : n[i] - n0;
+        if (rho_p) {
+            A->val[diag] = sum + d->s.compressibility / (dt * dt);
+            d->rhs[r] = d->s.relaxation / (dt * dt) * dn / n0;
+        } else {
+            A->val[diag] = sum + d->s.compressibility * rho / (dt * dt);
+            d->rhs[r] = d->s.relaxation * rho / (dt * dt) * dn / n0;
+        }
+        if (pd)
+            d->rhs[r] += known;
         if (d->s.compressibility > 0)
             touches[r] = 1;
-        d->rhs[r] = d->s.relaxation * rho / (dt * dt) * (n[i] - n0) / n0;
         d->x[r] = pressure[i]; /* warm start from the last step */
     }
     A->rowptr[nrows] = pos;
@@ -154,9 +179,10 @@ int mps_solve_ppe(mps_data *d, mf_sim *sim)
     mf_particles *p = sim->p;
     int rc = d->pressure_ops->solve(d->pressure.data, &d->A, d->rhs, d->x, &d->last);
     mf_log_printf(sim->log, MF_LOG_STEP,
-                  "%s:  Solving for p, Initial residual = %g, Final residual = %g, No "
+                  "%s:  Solving for %s, Initial residual = %g, Final residual = %g, No "
                   "Iterations %d\n",
-                  d->pressure.info->name, d->last.initial_residual, d->last.final_residual,
+                  d->pressure.info->name, d->solve_name ? d->solve_name : "p",
+                  d->last.initial_residual, d->last.final_residual,
                   d->last.iterations);
     sim->pressure_iterations += d->last.iterations;
     d->t_setup += d->last.setup_seconds;
@@ -166,7 +192,7 @@ int mps_solve_ppe(mps_data *d, mf_sim *sim)
         return mf_error_trace(rc, __FILE__, __LINE__, __func__);
     double *pressure = mf_particles_fd(p, d->f_pressure);
     for (size_t i = 0; i < p->n_owned; i++) {
-        double v = d->row[i] >= 0 ? d->x[d->row[i]] : 0.0;
+        double v = d->row[i] >= 0 ? d->x[d->row[i]] : (d->p_dirichlet ? d->p_dirichlet[i] : 0.0);
         pressure[i] = (d->s.clip_negative_pressure && v < 0) ? 0.0 : v;
     }
     return 0;

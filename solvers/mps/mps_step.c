@@ -57,7 +57,7 @@ int mps_build_neighbours(mps_data *d, mf_sim *sim, bool reorder)
     return 0;
 }
 
-static void set_masks(mps_data *d, const mf_particles *p)
+void mps_set_masks(mps_data *d, const mf_particles *p)
 {
     for (size_t i = 0; i < p->n; i++) {
         d->is_fluid[i] = p->kind[i] == MF_FLUID;
@@ -91,8 +91,12 @@ static void collide(mps_data *d, mf_sim *sim, double dt)
                 approach += (vi[c] - p->vel[3 * j + c]) * r[c] / len;
             if (approach <= 0)
                 continue;
-            /* Equal masses; a wall (fixed) counts as infinitely heavy. */
-            double share = d->is_fluid[j] ? 0.5 : 1.0;
+            /* Equal masses (one fluid) or masses in proportion to the
+             * densities (mps_data.rho); a wall (fixed) counts as
+             * infinitely heavy. */
+            double share = !d->is_fluid[j] ? 1.0
+                           : d->rho         ? d->rho[j] / (d->rho[i] + d->rho[j])
+                                            : 0.5;
             for (int c = 0; c < 3; c++)
                 vi[c] -= share * (1 + e) * approach * r[c] / len;
         }
@@ -105,18 +109,28 @@ static void collide(mps_data *d, mf_sim *sim, double dt)
             }
 }
 
-/* eqs. 9-10: u* = u + dt (nu lap u + forces), r* = r + dt u*. */
+/* eqs. 9-10: u* = u + dt (nu lap u + forces), r* = r + dt u*. With a
+ * density and viscosity per particle (mps_data.mu), eq. 27: each particle's
+ * own nu, pairs of unlike particles through mu_ij. */
 int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
 {
     double t0 = mf_wall_seconds();
     mf_particles *p = sim->p;
     const double nu = sim->fluid[0].nu;
     memset(d->acc, 0, 3 * p->n * sizeof *d->acc);
+    sim->neighbours = &d->nl_max; /* at r^n: forces that need neighbours use it */
     for (size_t k = 0; k < sim->nforces; k++) {
         const mf_force_ops *ops = (const mf_force_ops *)sim->forces[k].info;
-        MF_CALL(ops->accumulate(sim->forces[k].data, sim, d->acc));
+        int rc = ops->accumulate(sim->forces[k].data, sim, d->acc);
+        if (rc != 0) {
+            sim->neighbours = NULL;
+            return mf_error_trace(rc, __FILE__, __LINE__, __func__);
+        }
     }
-    if (nu > 0) {
+    sim->neighbours = NULL;
+    if (d->mu) {
+        mps_viscous_pairs(d, p, list_for(d, &d->nl_lap, d->k_lap.re), d->acc);
+    } else if (nu > 0) {
         const mf_nlist *nl = list_for(d, &d->nl_lap, d->k_lap.re);
         mf_laplacian(p, nl, &d->k_lap, p->vel, 3, d->is_fluid, NULL, d->grad);
         for (size_t i = 0; i < p->n_owned; i++)
@@ -138,8 +152,8 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
     return 0;
 }
 
-/* eqs. 11-14 and 18: number density at r*, free surface, PPE. */
-int mps_pressure_phase(mps_data *d, mf_sim *sim, double dt)
+/* eq. 18: number density at r*, free surface, the PPE's unknowns. */
+int mps_surface_phase(mps_data *d, mf_sim *sim)
 {
     double t0 = mf_wall_seconds();
     mf_particles *p = sim->p;
@@ -156,6 +170,13 @@ int mps_pressure_phase(mps_data *d, mf_sim *sim, double dt)
             n[i] = 0; /* dummies take part only as neighbours */
     }
     d->t_assembly += mf_wall_seconds() - t0;
+    return 0;
+}
+
+/* eqs. 11-14 and 18: number density at r*, free surface, PPE. */
+int mps_pressure_phase(mps_data *d, mf_sim *sim, double dt)
+{
+    MF_CALL(mps_surface_phase(d, sim));
     MF_CALL(mps_assemble_ppe(d, sim, dt));
     MF_CALL(mps_solve_ppe(d, sim));
     return 0;
@@ -167,6 +188,12 @@ int mps_correction_phase(mps_data *d, mf_sim *sim, double dt)
     double t0 = mf_wall_seconds();
     mf_particles *p = sim->p;
     const double *pr = mf_particles_fd(p, d->f_pressure);
+    if (d->rho) { /* a density per particle: 1/rho_ij in the sum */
+        mps_gradient_pairs(d, p, pr, NULL);
+        mps_apply_correction(d, p, dt, NULL);
+        d->t_correction += mf_wall_seconds() - t0;
+        return 0;
+    }
     mf_gradient(p, list_for(d, &d->nl_grad, d->k_grad.re), &d->k_grad, pr, d->s.gradient_pmin,
                 d->is_fluid, d->not_dummy, d->grad);
     const double rho = sim->fluid[0].rho;
@@ -187,7 +214,7 @@ int mps_lagrangian_step(mps_data *d, mf_sim *sim, double dt)
 {
     MF_CALL(mps_reserve(d, sim->p->n));
     MF_CALL(mps_build_neighbours(d, sim, true)); /* at r^n, for viscosity */
-    set_masks(d, sim->p);
+    mps_set_masks(d, sim->p);
     MF_CALL(mps_explicit_phase(d, sim, dt));
     MF_CALL(mps_build_neighbours(d, sim, false)); /* at r*, for the pressure */
     MF_CALL(mps_pressure_phase(d, sim, dt));

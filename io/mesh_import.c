@@ -1,0 +1,142 @@
+/* mesh_import.c: polygon files through assimp's C API (assimp/cimport.h). */
+#include "mf_mesh_import.h"
+
+#include <assimp/cimport.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "mf_error.h"
+
+/* Vertices of one assimp mesh, through the node's accumulated transform
+ * (a row-major 4x4 affine matrix). */
+static int add_mesh(mf_trimesh *out, const struct aiMesh *am, const struct aiMatrix4x4 *t)
+{
+    size_t base = out->nverts;
+    MF_CALL(mf_trimesh_reserve(out, base + am->mNumVertices, out->ntris + am->mNumFaces));
+    for (unsigned v = 0; v < am->mNumVertices; v++) {
+        const struct aiVector3D *p = &am->mVertices[v];
+        double x[3] = {
+            t->a1 * p->x + t->a2 * p->y + t->a3 * p->z + t->a4,
+            t->b1 * p->x + t->b2 * p->y + t->b3 * p->z + t->b4,
+            t->c1 * p->x + t->c2 * p->y + t->c3 * p->z + t->c4,
+        };
+        for (int a = 0; a < 3; a++)
+            if (!isfinite(x[a]))
+                return MF_ERROR(MF_ERR_INPUT, "%s: vertex %u has a non-finite coordinate",
+                                out->name, v);
+        MF_CALL(mf_trimesh_add_vertex(out, x));
+    }
+    for (unsigned f = 0; f < am->mNumFaces; f++) {
+        const struct aiFace *face = &am->mFaces[f];
+        if (face->mNumIndices != 3) { /* points and lines (polygons are triangulated) */
+            out->dropped++;
+            continue;
+        }
+        MF_CALL(mf_trimesh_add_triangle(out, (int32_t)(base + face->mIndices[0]),
+                                        (int32_t)(base + face->mIndices[1]),
+                                        (int32_t)(base + face->mIndices[2])));
+    }
+    return 0;
+}
+
+static void mat_mul(const struct aiMatrix4x4 *a, const struct aiMatrix4x4 *b,
+                    struct aiMatrix4x4 *c)
+{
+    const ai_real *x = &a->a1, *y = &b->a1;
+    ai_real r[16];
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++) {
+            ai_real s = 0;
+            for (int k = 0; k < 4; k++)
+                s += x[4 * i + k] * y[4 * k + j];
+            r[4 * i + j] = s;
+        }
+    memcpy(&c->a1, r, sizeof r);
+}
+
+static int add_node(mf_trimesh *out, const struct aiScene *sc, const struct aiNode *node,
+                    const struct aiMatrix4x4 *parent, int depth)
+{
+    if (depth > 64)
+        return MF_ERROR(MF_ERR_INPUT, "%s: scene graph nested more than 64 deep", out->name);
+    struct aiMatrix4x4 t;
+    mat_mul(parent, &node->mTransformation, &t);
+    for (unsigned k = 0; k < node->mNumMeshes; k++)
+        if (node->mMeshes[k] < sc->mNumMeshes)
+            MF_CALL(add_mesh(out, sc->mMeshes[node->mMeshes[k]], &t));
+    for (unsigned k = 0; k < node->mNumChildren; k++)
+        MF_CALL(add_node(out, sc, node->mChildren[k], &t, depth + 1));
+    return 0;
+}
+
+int mf_mesh_import(const char *path, mf_trimesh *out)
+{
+    size_t len = strlen(path) < sizeof out->name - 1 ? strlen(path) : sizeof out->name - 1;
+    memcpy(out->name, path, len);
+    out->name[len] = '\0';
+    struct stat st;
+    if (stat(path, &st) != 0)
+        return MF_ERROR(MF_ERR_IO, "%s: cannot open (%s)", path, strerror(errno));
+    if (!S_ISREG(st.st_mode))
+        return MF_ERROR(MF_ERR_IO, "%s: not a regular file", path);
+    if (st.st_size == 0)
+        return MF_ERROR(MF_ERR_INPUT, "%s: the file is empty (0 bytes)", path);
+    const struct aiScene *sc =
+        aiImportFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                               aiProcess_SortByPType);
+    if (!sc)
+        return MF_ERROR(MF_ERR_INPUT, "%s: not a polygon file assimp can read (%s)", path,
+                        aiGetErrorString());
+    int rc = 0;
+    if (sc->mRootNode) {
+        struct aiMatrix4x4 id = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+        rc = add_node(out, sc, sc->mRootNode, &id, 0);
+    }
+    aiReleaseImport(sc);
+    MF_CALL(rc);
+    if (out->ntris == 0)
+        return MF_ERROR(MF_ERR_INPUT, "%s: holds no triangle or polygon (%zu vertices, %zu points "
+                        "or lines): nothing to make a surface of", path, out->nverts,
+                        out->dropped);
+    double mn[3], mx[3], extent = 0;
+    mf_trimesh_bounds(out, mn, mx);
+    for (int a = 0; a < 3; a++)
+        extent = fmax(extent, mx[a] - mn[a]);
+    return mf_trimesh_weld(out, 1e-9 * extent);
+}
+
+static int read_in_case(void *ctx, const char *file, const char *relative_to, mf_trimesh *out)
+{
+    (void)ctx;
+    if (file[0] == '/' || !relative_to)
+        return mf_mesh_import(file, out);
+    char dir[4096];
+    snprintf(dir, sizeof dir, "%s", relative_to);
+    char *slash = strrchr(dir, '/');
+    if (slash)
+        slash[1] = '\0';
+    else
+        dir[0] = '\0';
+    char a[8192], b[8192];
+    snprintf(a, sizeof a, "%s%s", dir, file);
+    snprintf(b, sizeof b, "%striSurface/%s", dir, file);
+    struct stat st;
+    if (stat(a, &st) == 0)
+        return mf_mesh_import(a, out);
+    if (stat(b, &st) == 0)
+        return mf_mesh_import(b, out);
+    size_t len = strlen(a) < sizeof out->name - 1 ? strlen(a) : sizeof out->name - 1;
+    memcpy(out->name, a, len);
+    out->name[len] = '\0';
+    return MF_ERROR(MF_ERR_IO, "polygon file '%s' not found (looked for %s and %s)", file, a, b);
+}
+
+mf_trimesh_reader mf_mesh_import_reader(void)
+{
+    return (mf_trimesh_reader){read_in_case, NULL};
+}

@@ -1,0 +1,781 @@
+/* surface_tension.c: the surface tension force of the paper's Appendix A
+ * (after Nomura et al. 2001), eq. 33's sigma kappa delta n per unit volume,
+ * returned as the acceleration f_st / rho_x of eq. 27.
+ *
+ * Interface particles. A fluid particle of fluid x is on an interface when a
+ * particle of another fluid lies within r_st, or (free surface) when fewer
+ * particles of any kind than beta N_full lie within r_st, N_full being the
+ * count of a full lattice (a free surface counts only where the fluid's
+ * sigma > 0). Walls and dummies count as the particle's own fluid (no
+ * contact-angle model).
+ *
+ * Curvature (eqs. 34-39). n^st1_i counts the own-fluid particles within r_st
+ * (eqs. 34-35, w = 1 inside r_st); n^st2_i counts only those deeper inside
+ * than i, n^st1_j > n^st1_i (eqs. 36-37), a tie counting one half so that
+ * a particle's own layer is neither in nor out whatever the disorder; walls
+ * count as deeper. n0^st is n^st2 at a flat interface (kappa = 0), computed
+ * on the lattice the same way (it comes out N_full / 2). With the fraction
+ * f = n^st2 / (2 n0^st) of the r_st disk (ball) that the fluid fills:
+ *   curvature paper: 2 theta = pi n^st2 / n0^st, kappa = 2 cos(theta) / r_st
+ *                    (eqs. 38-39; they take the fluid's part of the disk as
+ *                    the sector of angle 2 theta);
+ *   curvature exact (default): f inverted through the exact area of a disk
+ *                    of radius r_st centred on a circle of radius R (2-D),
+ *                    or the volume of a ball centred on a sphere (3-D,
+ *                    f = 1/2 - 3 r_st / (16 R), kappa = 2/R, the sum of the
+ *                    principal curvatures, so that dp = sigma kappa gives
+ *                    Laplace's 2 sigma / R).
+ * Why exact by default: the sector leaves out the two segments between the
+ * chords and the arc, so that f = 1/2 - r_st/(3 pi R) + ... where the
+ * sector gives 1/2 - r_st/(2 pi R): eqs. 38-39 return 2/3 of the curvature
+ * (measured on lattice droplets: 0.68 of 1/R at R = 10-40 l0, against 1.02
+ * to 1.07 with the exact area; README, "Multi-fluid").
+ *
+ * delta n (eq. 33). The interface normal and delta come from the gradient of
+ * the colour C_x (1 in fluid x, 0 elsewhere) with the MPS gradient (eq. 5)
+ * and weight (eq. 3) of radius r_st:
+ *   another fluid y:  g^y_i = -(d/n0) sum_{j in y} r_ij w_ij / |r_ij|^2,
+ *   free surface:     g^0_i = (d/n0) sum_{j present} r_ij w_ij / |r_ij|^2
+ *                     (the missing neighbours' share of the same sum).
+ * Across a flat interface the sum of g over a column of particles is half
+ * the jump of C on each side (exactly so for the lattice: (d/n0) sum_j
+ * r_y^2 w / r^2 = 1, half from each side), so each side of a fluid/fluid
+ * interface takes sigma_xy kappa_i g^y_i and a free surface, which has one
+ * side, takes 2 sigma_x kappa_i g^0_i. The force per unit volume integrated
+ * across the interface is then sigma kappa: the pressure jump is Laplace's.
+ *
+ * Tension of a pair: sigma_xy of an `interfaces` entry, else Antonow's rule
+ * |sigma_x - sigma_y| (a fluid against one with sigma 0 keeps its own
+ * sigma); a free surface of fluid x: sigma_x.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "forces.h"
+#include "mf_error.h"
+#include "mf_kernel.h"
+#include "mf_neighbours.h"
+#include "mf_scene.h"
+
+typedef struct st_settings {
+    double radius;          /* r_st in l0 */
+    const char *curvature;  /* exact | paper */
+    double beta;            /* free surface below beta N_full */
+    double dt_factor;       /* capillary time step factor */
+    long smoothing;         /* passes of curvature smoothing */
+    const mf_dict *interfaces;
+} st_settings;
+
+static const char *const curvature_models[] = {"exact", "paper", "normal", NULL};
+
+static const mf_param st_params[] = {
+    {"radius", MF_PARAM_SCALAR, "4.1", 1.5, 10, NULL, offsetof(st_settings, radius),
+     "r_st, the radius of the surface-tension number densities (eqs. 34-37), in l0"},
+    {"curvature", MF_PARAM_WORD, "normal", MF_NO_RANGE, curvature_models,
+     offsetof(st_settings, curvature),
+     "kappa from n^st2: exact (disk/ball intersection) or paper (eqs. 38-39, 2/3 of it); "
+     "or normal: the divergence of the interface normal (Brackbill et al. 1992)"},
+    {"beta", MF_PARAM_SCALAR, "0.85", 0.5, 1, NULL, offsetof(st_settings, beta),
+     "free-surface interface where fewer than beta N_full particles lie within r_st"},
+    {"dtFactor", MF_PARAM_SCALAR, "1", 0.01, 10, NULL, offsetof(st_settings, dt_factor),
+     "dt <= dtFactor sqrt(rho l0^3 / (2 pi sigma)) (Brackbill et al. 1992); rho: the pair's "
+     "mean density"},
+    {"smoothing", MF_PARAM_INT, "1", 0, 10, NULL, offsetof(st_settings, smoothing),
+     "passes of curvature averaging over the free-surface particles within r_st (0: none)"},
+    {"interfaces", MF_PARAM_DICT, NULL, MF_NO_RANGE, NULL, offsetof(st_settings, interfaces),
+     "tension of fluid pairs: name { fluids (a b); sigma 0.03; } (else |sigma_a - sigma_b|)"},
+};
+#define ST_NPARAMS (sizeof st_params / sizeof st_params[0])
+
+#define EXACT_TABLE 2001 /* the 2-D area fraction F(eps), eps = r_st / R in [0, 2] */
+
+typedef struct st_data {
+    st_settings s;
+    bool paper, normal;
+    double g_ref;              /* |delta n| of the outer layer of a flat lattice surface */
+    int dim;
+    double l0, r;              /* r = r_st in m */
+    int nfluids;
+    double sigma[MF_MAX_FLUIDS][MF_MAX_FLUIDS]; /* fluid pairs; [x][x]: free surface of x */
+    bool any;                  /* some tension is > 0 */
+    double n_full, n0st;       /* eqs. 34-39 on the lattice */
+    double g_coef;             /* d / sum_lattice r phi(r): the colour gradient's constant */
+    double table_f[EXACT_TABLE];
+    int f_curvature;           /* Curvature field */
+    int f_accel;               /* SurfaceTension field: f_st / rho_x, m/s^2 */
+    mf_grid grid;
+    mf_nlist nl;               /* own list when the solver's is too short */
+    size_t cap;
+    int32_t *n1, *nall;
+    double *kappa, *kappa_s, *fdir;
+    double *nrm;               /* outward unit normal of the particle's own fluid; 0: none */
+} st_data;
+
+/* ---- curvature from the filled fraction f of the r_st disk (ball) --------- */
+
+/* 2-D: the part of a disk of radius r centred on a circle of radius R that
+ * lies inside the circle, as a fraction of the disk; eps = r / R in (0, 2]. */
+static double disk_fraction(double eps)
+{
+    if (eps <= 0)
+        return 0.5;
+    return (acos(eps / 2) + acos(1 - eps * eps / 2) / (eps * eps) -
+            sqrt(4 - eps * eps) / (2 * eps)) /
+           M_PI;
+}
+
+/* eps >= 0 with disk_fraction(eps) = f, f in [1/4, 1/2] (clamped). */
+static double invert_disk_fraction(const st_data *d, double f)
+{
+    const double *t = d->table_f; /* decreasing from 1/2 to 1/4 */
+    if (f >= t[0])
+        return 0;
+    if (f <= t[EXACT_TABLE - 1])
+        return 2;
+    size_t lo = 0, hi = EXACT_TABLE - 1;
+    while (hi - lo > 1) {
+        size_t mid = (lo + hi) / 2;
+        if (t[mid] > f)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    double a = t[lo], b = t[hi], s = (a - f) / (a - b);
+    return 2.0 * ((double)lo + s) / (EXACT_TABLE - 1);
+}
+
+/* kappa (1/m) of a particle whose fluid fills the fraction f of its probe. */
+static double curvature(const st_data *d, double f)
+{
+    if (d->paper) { /* eqs. 38-39: 2 theta = pi n^st2 / n0^st = 2 pi f */
+        double theta = M_PI * f;
+        return 2 * cos(theta) / d->r;
+    }
+    double sign = f <= 0.5 ? 1.0 : -1.0; /* concave: the other side's convex fraction */
+    double g = f <= 0.5 ? f : 1 - f, eps;
+    if (d->dim == 2) {
+        eps = invert_disk_fraction(d, g);
+        return sign * eps / d->r;
+    }
+    eps = fmin(2.0, 16.0 / 3.0 * (0.5 - g)); /* ball on a sphere: f = 1/2 - 3 eps / 16 */
+    return sign * 2 * eps / d->r;             /* 2/R */
+}
+
+/* ---- lattice constants ---------------------------------------------------- */
+
+/* The weight of the colour gradient (delta n): the gradient of the smooth
+ * number density sum_j phi(r_ij), phi = (1 - r/r_st)^2. Not the MPS weight
+ * re/r - 1: its 1/r singularity lets the nearest neighbour decide the
+ * normal, and when the outer layer is pressed onto the next one, that
+ * layer's normal turns outward and the force pushes it out (measured on a
+ * 2-D drop: the integrated force fell from sigma/R to 0.2 sigma/R within
+ * 0.1 s). */
+static inline double colour_weight(double r, double rst)
+{
+    return r < rst ? (1 - r / rst) * (1 - r / rst) : 0.0;
+}
+
+/* N_full: lattice points within r_st; n0^st: n^st2 of a particle on a flat
+ * lattice surface (deeper layers count 1, its own layer one half). */
+static void lattice_counts(st_data *d)
+{
+    int m = (int)ceil(d->s.radius), mz = d->dim == 3 ? m : 0;
+    double full = 0, flat = 0, rphi = 0, gy = 0;
+    const double r2 = d->s.radius * d->s.radius;
+    for (int i = -m; i <= m; i++)
+        for (int j = -m; j <= m; j++)
+            for (int k = -mz; k <= mz; k++) {
+                double q = (double)(i * i + j * j + k * k);
+                if (q == 0 || q >= r2)
+                    continue;
+                full += 1;
+                double r = sqrt(q) * d->l0;
+                rphi += r * colour_weight(r, d->r);
+                if (j <= 0) /* the outer particle of a flat surface: colour gradient */
+                    gy += colour_weight(r, d->r) * (j * d->l0) / r;
+                /* the interface is normal to y; fluid at y <= 0 */
+                if (j < 0)
+                    flat += 1;
+                else if (j == 0)
+                    flat += 0.5;
+            }
+    d->n_full = full;
+    d->n0st = flat;
+    d->g_coef = d->dim / rphi;
+    d->g_ref = fabs(d->g_coef * gy);
+}
+
+/* ---- pair tensions --------------------------------------------------------- */
+
+typedef struct pair_settings {
+    double sigma;
+} pair_settings;
+
+static const mf_param pair_params[] = {
+    {"sigma", MF_PARAM_SCALAR, NULL, 0, 1e6, NULL, offsetof(pair_settings, sigma),
+     "tension of the interface, N/m"},
+};
+static const char *const pair_extra[] = {"fluids", NULL};
+
+static int read_interface(st_data *d, const mf_sim *sim, const mf_entry *e)
+{
+    char where[512];
+    if (e->n != 1 || e->items[0]->kind != MF_VAL_DICT)
+        return MF_ERROR(MF_ERR_INPUT,
+                        "%s: interface '%s' must be a sub-dictionary { fluids (a b); sigma s; }",
+                        mf_loc_str(e->loc, where, sizeof where), e->key);
+    const mf_dict *id = e->items[0]->dict;
+    pair_settings ps;
+    MF_CALL(mf_params_apply(pair_params, 1, id, pair_extra, &ps, NULL));
+    mf_entry *fe = mf_dict_find(id, "fluids");
+    if (!fe || fe->n != 1 || fe->items[0]->kind != MF_VAL_LIST || fe->items[0]->n != 2)
+        return MF_ERROR(MF_ERR_INPUT, "%s: interface '%s': 'fluids' takes two fluid names, e.g. "
+                        "fluids (oil water);",
+                        mf_loc_str(fe ? fe->loc : id->loc, where, sizeof where), e->key);
+    fe->used = true;
+    int k[2];
+    for (int q = 0; q < 2; q++) {
+        const mf_value *v = fe->items[0]->items[q];
+        if (v->kind != MF_VAL_WORD && v->kind != MF_VAL_STRING)
+            return MF_ERROR(MF_ERR_INPUT, "%s: interface '%s': a fluid name is expected",
+                            mf_loc_str(v->loc, where, sizeof where), e->key);
+        if (mf_scene_fluid_index(sim, v->text, &k[q]) != 0)
+            return MF_ERROR(MF_ERR_INPUT, "%s: interface '%s': %s",
+                            mf_loc_str(v->loc, where, sizeof where), e->key,
+                            mf_error_message());
+    }
+    if (k[0] == k[1])
+        return MF_ERROR(MF_ERR_INPUT, "%s: interface '%s' names fluid '%s' twice (its free "
+                        "surface takes sigma from constant/fluids)",
+                        mf_loc_str(fe->loc, where, sizeof where), e->key,
+                        sim->fluid[k[0]].name);
+    d->sigma[k[0]][k[1]] = d->sigma[k[1]][k[0]] = ps.sigma;
+    return 0;
+}
+
+static int setup_tensions(st_data *d, const mf_sim *sim)
+{
+    d->nfluids = sim->nfluids;
+    for (int x = 0; x < sim->nfluids; x++)
+        for (int y = 0; y < sim->nfluids; y++)
+            d->sigma[x][y] = x == y ? sim->fluid[x].sigma
+                                    : fabs(sim->fluid[x].sigma - sim->fluid[y].sigma);
+    for (size_t k = 0; d->s.interfaces && k < d->s.interfaces->n; k++) {
+        mf_entry *e = d->s.interfaces->entries[k];
+        e->used = true;
+        MF_CALL(read_interface(d, sim, e));
+    }
+    d->any = false;
+    for (int x = 0; x < sim->nfluids; x++)
+        for (int y = 0; y < sim->nfluids; y++)
+            d->any = d->any || d->sigma[x][y] > 0;
+    return 0;
+}
+
+/* ---- the module -------------------------------------------------------------- */
+
+static void st_destroy(void *data)
+{
+    st_data *d = data;
+    if (!d)
+        return;
+    mf_grid_free(&d->grid);
+    mf_nlist_free(&d->nl);
+    free(d->n1);
+    free(d->nall);
+    free(d->kappa);
+    free(d->kappa_s);
+    free(d->fdir);
+    free(d->nrm);
+    free(d);
+}
+
+static int st_create_data(const st_settings *s, mf_sim *sim, st_data *d)
+{
+    d->s = *s;
+    d->paper = strcmp(s->curvature, "paper") == 0;
+    d->normal = strcmp(s->curvature, "normal") == 0;
+    d->dim = sim->dim;
+    d->l0 = sim->l0;
+    d->r = s->radius * sim->l0;
+    mf_grid_init(&d->grid);
+    mf_nlist_init(&d->nl);
+    lattice_counts(d);
+    for (int i = 0; i < EXACT_TABLE; i++)
+        d->table_f[i] = disk_fraction(2.0 * i / (EXACT_TABLE - 1));
+    MF_CALL(setup_tensions(d, sim));
+    MF_CALL(mf_particles_request_field(sim->p, "Curvature", 1, MF_FIELD_DOUBLE, true,
+                                       &d->f_curvature));
+    MF_CALL(mf_particles_request_field(sim->p, "SurfaceTension", 3, MF_FIELD_DOUBLE, true,
+                                       &d->f_accel));
+    mf_log_printf(sim->log, MF_LOG_NORMAL,
+                  "surfaceTension: r_st = %g l0, N_full = %g, n0^st = %g (flat interface), "
+                  "curvature %s\n",
+                  s->radius, d->n_full, d->n0st, s->curvature);
+    for (int x = 0; x < sim->nfluids; x++)
+        for (int y = x; y < sim->nfluids; y++)
+            if (d->sigma[x][y] > 0) {
+                if (x == y)
+                    mf_log_printf(sim->log, MF_LOG_NORMAL,
+                                  "surfaceTension: free surface of %s: sigma = %g N/m\n",
+                                  sim->fluid[x].name, d->sigma[x][y]);
+                else
+                    mf_log_printf(sim->log, MF_LOG_NORMAL,
+                                  "surfaceTension: interface %s/%s: sigma = %g N/m\n",
+                                  sim->fluid[x].name, sim->fluid[y].name, d->sigma[x][y]);
+            }
+    if (!d->any)
+        mf_log_printf(sim->log, MF_LOG_NORMAL,
+                      "surfaceTension: every sigma is 0 (constant/fluids): no force\n");
+    return 0;
+}
+
+static int st_create(const void *settings, mf_sim *sim, void **data)
+{
+    st_data *d = calloc(1, sizeof *d);
+    if (!d)
+        return MF_ERROR(MF_ERR_MEMORY, "out of memory");
+    int rc = st_create_data(settings, sim, d);
+    if (rc != 0) {
+        st_destroy(d);
+        return mf_error_trace(rc, __FILE__, __LINE__, __func__);
+    }
+    *data = d;
+    return 0;
+}
+
+/* Neighbours within r_st: the solver's list when it reaches, else our own. */
+static int neighbours(st_data *d, const mf_sim *sim, const mf_nlist **out)
+{
+    if (sim->neighbours && sim->neighbours->radius >= d->r &&
+        sim->neighbours->n >= sim->p->n_owned) {
+        *out = sim->neighbours;
+        return 0;
+    }
+    MF_CALL(mf_grid_build(&d->grid, sim->p, d->r));
+    MF_CALL(mf_nlist_build(&d->nl, &d->grid, sim->p, d->r));
+    *out = &d->nl;
+    return 0;
+}
+
+static inline double dist(const double *xi, const double *xj, double r[3])
+{
+    r[0] = xj[0] - xi[0];
+    r[1] = xj[1] - xi[1];
+    r[2] = xj[2] - xi[2];
+    return sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+}
+
+static inline int fluid_of(const int32_t *fid, size_t i) { return fid ? fid[i] : 0; }
+
+/* Same fluid as x (walls and dummies count as every fluid's own). */
+static inline bool own(const mf_particles *p, const int32_t *fid, size_t j, int x)
+{
+    return p->kind[j] != MF_FLUID || fluid_of(fid, j) == x;
+}
+
+/* Work arrays, one entry per particle. */
+static int reserve(st_data *d, size_t n)
+{
+    if (n <= d->cap)
+        return 0;
+    size_t cap = n + n / 4 + 64;
+    int32_t *n1 = realloc(d->n1, cap * sizeof *n1);
+    if (n1)
+        d->n1 = n1;
+    int32_t *nall = realloc(d->nall, cap * sizeof *nall);
+    if (nall)
+        d->nall = nall;
+    double *k = realloc(d->kappa, cap * sizeof *k);
+    if (k)
+        d->kappa = k;
+    double *ks = realloc(d->kappa_s, cap * sizeof *ks);
+    if (ks)
+        d->kappa_s = ks;
+    double *f = realloc(d->fdir, 3 * cap * sizeof *f);
+    if (f)
+        d->fdir = f;
+    double *nr = realloc(d->nrm, 3 * cap * sizeof *nr);
+    if (nr)
+        d->nrm = nr;
+    if (!n1 || !nall || !k || !ks || !f || !nr)
+        return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu particles", n);
+    d->cap = cap;
+    return 0;
+}
+
+/* eqs. 34-35: n^st1 (own fluid, walls included) and the count of every
+ * particle within r_st. */
+static void count_neighbours(st_data *d, const mf_particles *p, const int32_t *fid,
+                             const mf_nlist *nl)
+{
+    const double rst = d->r;
+    const long np = (long)p->n_owned;
+#pragma omp parallel for schedule(static)
+    for (long i = 0; i < np; i++) {
+        int32_t own_count = 0, all = 0;
+        if (p->kind[i] == MF_FLUID) {
+            int x = fluid_of(fid, (size_t)i);
+            double r[3];
+            for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
+                size_t j = nl->j[k];
+                if (dist(&p->pos[3 * i], &p->pos[3 * j], r) >= rst)
+                    continue;
+                all++;
+                own_count += own(p, fid, j, x);
+            }
+        }
+        d->n1[i] = own_count;
+        d->nall[i] = all;
+    }
+}
+
+/* The full count of the current packing: the mean count of the fluid
+ * particles deeper than r_st inside (no particle within r_st that misses
+ * neighbours); the lattice's N_full until there are such particles.
+ * Disorder changes the count by a particle or two out of 30, which the
+ * curvature of eqs. 38-39 would read as 0.05 / l0; a count-based choice of
+ * the particles (count above a threshold) would be biased the same way. */
+static double measured_full_count(const st_data *d, const mf_particles *p, const mf_nlist *nl)
+{
+    const double thr = d->s.beta * d->n_full, rst = d->r;
+    double sum = 0;
+    size_t count = 0;
+    for (size_t i = 0; i < p->n_owned; i++) {
+        if (p->kind[i] != MF_FLUID || d->nall[i] < thr)
+            continue;
+        bool deep = true;
+        double r[3];
+        for (size_t k = nl->start[i]; k < nl->start[i + 1] && deep; k++) {
+            size_t j = nl->j[k];
+            deep = !(p->kind[j] == MF_FLUID && d->nall[j] < thr &&
+                     dist(&p->pos[3 * i], &p->pos[3 * j], r) < rst);
+        }
+        if (deep) {
+            sum += d->nall[i];
+            count++;
+        }
+    }
+    return count ? sum / (double)count : d->n_full;
+}
+
+/* The normals averaged over the interface particles within r_st (weight
+ * psi, another fluid's normal reversed) and renormalised: on a lattice the
+ * raw normals follow the staircase of the particle rows, whose divergence
+ * is noise of the order of 1 / l0. kappa_s is the scratch copy. */
+static void smooth_normals(st_data *d, const mf_particles *p, const int32_t *fid,
+                           const mf_nlist *nl)
+{
+    const double rst = d->r;
+    const long np = (long)p->n_owned;
+    double *out = d->fdir; /* fdir[3i] (free-surface mark) is saved below */
+    double *mark = d->kappa_s;
+#pragma omp parallel for schedule(dynamic, 64)
+    for (long i = 0; i < np; i++) {
+        mark[i] = d->fdir[3 * i];
+    }
+#pragma omp parallel for schedule(dynamic, 64)
+    for (long i = 0; i < np; i++) {
+        const double *ni = &d->nrm[3 * i];
+        double m[3] = {ni[0], ni[1], ni[2]}, r[3];
+        if (m[0] != 0 || m[1] != 0 || m[2] != 0) {
+            const int x = fluid_of(fid, (size_t)i);
+            for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
+                size_t j = nl->j[k];
+                if (p->kind[j] != MF_FLUID)
+                    continue;
+                double len = dist(&p->pos[3 * i], &p->pos[3 * j], r);
+                if (len >= rst || len <= 0)
+                    continue;
+                double w = colour_weight(len, rst) * (fluid_of(fid, j) == x ? 1.0 : -1.0);
+                for (int c = 0; c < 3; c++)
+                    m[c] += w * d->nrm[3 * j + c];
+            }
+            double len = sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+            for (int c = 0; c < 3; c++)
+                m[c] = len > 0 ? m[c] / len : 0.0;
+        }
+        for (int c = 0; c < 3; c++)
+            out[3 * i + c] = m[c];
+    }
+    for (long i = 0; i < np; i++) {
+        for (int c = 0; c < 3; c++) {
+            double t = d->nrm[3 * i + c];
+            d->nrm[3 * i + c] = out[3 * i + c];
+            out[3 * i + c] = t;
+        }
+        out[3 * i] = mark[i];
+    }
+}
+
+/* Inverse of a symmetric 2x2 or 3x3 matrix; false when nearly singular. */
+static bool invert_sym(int dim, const double m[3][3], double inv[3][3])
+{
+    if (dim == 2) {
+        double det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
+        double scale = m[0][0] * m[1][1];
+        if (!(fabs(det) > 1e-6 * fabs(scale)) || det == 0)
+            return false;
+        memset(inv, 0, 9 * sizeof(double));
+        inv[0][0] = m[1][1] / det;
+        inv[1][1] = m[0][0] / det;
+        inv[0][1] = inv[1][0] = -m[0][1] / det;
+        return true;
+    }
+    double c00 = m[1][1] * m[2][2] - m[1][2] * m[2][1], c01 = m[1][2] * m[2][0] - m[1][0] * m[2][2],
+           c02 = m[1][0] * m[2][1] - m[1][1] * m[2][0];
+    double det = m[0][0] * c00 + m[0][1] * c01 + m[0][2] * c02;
+    double scale = m[0][0] * m[1][1] * m[2][2];
+    if (!(fabs(det) > 1e-6 * fabs(scale)) || det == 0)
+        return false;
+    inv[0][0] = c00 / det;
+    inv[0][1] = (m[0][2] * m[2][1] - m[0][1] * m[2][2]) / det;
+    inv[0][2] = (m[0][1] * m[1][2] - m[0][2] * m[1][1]) / det;
+    inv[1][0] = c01 / det;
+    inv[1][1] = (m[0][0] * m[2][2] - m[0][2] * m[2][0]) / det;
+    inv[1][2] = (m[0][2] * m[1][0] - m[0][0] * m[1][2]) / det;
+    inv[2][0] = c02 / det;
+    inv[2][1] = (m[0][1] * m[2][0] - m[0][0] * m[2][1]) / det;
+    inv[2][2] = (m[0][0] * m[1][1] - m[0][1] * m[1][0]) / det;
+    return true;
+}
+
+/* curvature normal: kappa = div n (n the outward unit normal; Brackbill et
+ * al. 1992) from the MPS gradient (eq. 5) of n over the neighbours that
+ * have a normal, corrected by the moment matrix of those neighbours,
+ *   grad n = [sum_j psi (n_j - n_i) r_ij^T / r^2] [sum_j psi r_ij r_ij^T / r^2]^-1,
+ * psi = (1 - r/r_st)^2, exact for a linear field whatever the neighbours (the
+ * interface band is one-sided: the plain MPS divergence reads twice the
+ * curvature there). A particle of another fluid contributes minus its normal
+ * (the same interface seen from the other side). Insensitive to a change of
+ * the particle density, which moves the counts of eq. 39. */
+static void normal_divergence(st_data *d, const mf_particles *p, const int32_t *fid,
+                              const mf_nlist *nl)
+{
+    const double rst = d->r;
+    const int dim = d->dim;
+    const long np = (long)p->n_owned;
+    const double *nv = d->nrm;
+#pragma omp parallel for schedule(dynamic, 64)
+    for (long i = 0; i < np; i++) {
+        if (isnan(d->kappa[i]))
+            continue;
+        const double *ni = &nv[3 * i];
+        if (ni[0] == 0 && ni[1] == 0 && ni[2] == 0) {
+            d->kappa[i] = 0;
+            continue;
+        }
+        const int x = fluid_of(fid, (size_t)i);
+        double A[3][3] = {{0}}, M[3][3] = {{0}}, r[3];
+        for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
+            size_t j = nl->j[k];
+            if (p->kind[j] != MF_FLUID)
+                continue;
+            const double *nj = &nv[3 * j];
+            if (nj[0] == 0 && nj[1] == 0 && nj[2] == 0)
+                continue;
+            double len = dist(&p->pos[3 * i], &p->pos[3 * j], r);
+            if (len >= rst || len <= 0)
+                continue;
+            double sign = fluid_of(fid, j) == x ? 1.0 : -1.0;
+            double w = colour_weight(len, rst) / (len * len);
+            for (int a = 0; a < dim; a++)
+                for (int b = 0; b < dim; b++) {
+                    A[a][b] += w * (sign * nj[a] - ni[a]) * r[b];
+                    M[a][b] += w * r[a] * r[b];
+                }
+        }
+        double inv[3][3];
+        double kappa = 0;
+        if (invert_sym(dim, M, inv))
+            for (int a = 0; a < dim; a++)
+                for (int b = 0; b < dim; b++)
+                    kappa += A[a][b] * inv[b][a];
+        /* A particle cannot resolve a radius below r_st / 2 (the count
+         * models' limit too): a corner's normals would ask for more. */
+        const double kmax = (dim == 3 ? 4.0 : 2.0) / rst;
+        d->kappa[i] = fmax(-kmax, fmin(kmax, kappa));
+    }
+}
+
+static int st_accumulate(void *data, const mf_sim *sim, double *acc)
+{
+    st_data *d = data;
+    const mf_particles *p = sim->p;
+    double *kappa_out = mf_particles_fd(p, d->f_curvature);
+    double *accel_out = mf_particles_fd(p, d->f_accel);
+    memset(kappa_out, 0, p->n * sizeof *kappa_out);
+    memset(accel_out, 0, 3 * p->n * sizeof *accel_out);
+    if (!d->any)
+        return 0;
+    const mf_nlist *nl = NULL;
+    MF_CALL(neighbours(d, sim, &nl));
+    MF_CALL(reserve(d, p->n));
+    int ff = mf_particles_field_index(p, "FluidId");
+    const int32_t *fid = ff >= 0 ? mf_particles_fi(p, ff) : NULL;
+    const double rst = d->r;
+    const long np = (long)p->n_owned;
+    const int32_t *n1 = d->n1;
+    count_neighbours(d, p, fid, nl);
+    const double n_full = measured_full_count(d, p, nl);
+    /* Interface particles and their curvature (eqs. 36-39); kappa = NAN
+     * off the interface. fdir[3i] = 1 marks a free surface. */
+#pragma omp parallel for schedule(dynamic, 64)
+    for (long i = 0; i < np; i++) {
+        d->kappa[i] = NAN;
+        d->nrm[3 * i] = d->nrm[3 * i + 1] = d->nrm[3 * i + 2] = 0;
+        if (p->kind[i] != MF_FLUID)
+            continue;
+        const int x = fluid_of(fid, (size_t)i);
+        double n2 = 0, r[3], g[3] = {0, 0, 0};
+        bool other = false;
+        for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
+            size_t j = nl->j[k];
+            double len = dist(&p->pos[3 * i], &p->pos[3 * j], r);
+            if (len >= rst || len <= 0)
+                continue;
+            /* colour gradient of the own fluid: toward own, away from others */
+            double s = (own(p, fid, j, x) ? 1.0 : -1.0) * colour_weight(len, rst) / len;
+            for (int c = 0; c < 3; c++)
+                g[c] += s * r[c];
+            if (own(p, fid, j, x)) {
+                if (p->kind[j] != MF_FLUID || n1[j] > n1[i])
+                    n2 += 1; /* eq. 37: deeper inside than i */
+                else if (n1[j] == n1[i])
+                    n2 += 0.5;
+            } else if (d->sigma[x][fluid_of(fid, j)] > 0) {
+                other = true;
+            }
+        }
+        bool free_surface = d->nall[i] < d->s.beta * n_full && d->sigma[x][x] > 0;
+        d->fdir[3 * i] = free_surface;
+        double gm = d->g_coef * sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+        bool interface = other || free_surface;
+        for (int c = 0; c < 3; c++) /* outward: against the colour gradient */
+            d->nrm[3 * i + c] =
+                interface && gm >= 0.1 * d->g_ref ? -d->g_coef * g[c] / gm : 0.0;
+        if (!interface)
+            continue;
+        /* eq. 39: n^st2 against its flat-interface value n0^st, half the full
+         * count. Where the probe is full (an interface between fluids), the
+         * particle's own count of every particle is that full count. */
+        double full = free_surface ? n_full : (double)d->nall[i];
+        d->kappa[i] = d->normal ? 0.0 : curvature(d, n2 / full);
+    }
+    if (d->normal) {
+        smooth_normals(d, p, fid, nl);
+        normal_divergence(d, p, fid, nl);
+    }
+    /* Smoothing (free surfaces): the mean of kappa over the free-surface
+     * particles of the same fluid within r_st, weight 1 - r/r_st. A free
+     * surface is picked by a count and its normal is one-sided: in motion its
+     * curvature is noisy, and the noise, multiplied by delta n, does not
+     * average out (a 2-D drop: the force jump 1.26 sigma/R unsmoothed, 1.02
+     * smoothed). An interface between fluids is not smoothed: there the
+     * average over its band of 2 r_st would pull kappa down (0.87 of 1/R on
+     * a lattice drop). */
+    double *kin = d->kappa, *kout = d->kappa_s;
+    for (long pass = 0; pass < d->s.smoothing; pass++) {
+#pragma omp parallel for schedule(dynamic, 64)
+        for (long i = 0; i < np; i++) {
+            kout[i] = kin[i];
+            if (isnan(kin[i]) || d->fdir[3 * i] == 0) /* free-surface particles only */
+                continue;
+            const int x = fluid_of(fid, (size_t)i);
+            double sw = 1, sk = kin[i], r[3];
+            for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
+                size_t j = nl->j[k];
+                if (isnan(kin[j]) || d->fdir[3 * j] == 0 || p->kind[j] != MF_FLUID ||
+                    fluid_of(fid, j) != x)
+                    continue;
+                double len = dist(&p->pos[3 * i], &p->pos[3 * j], r);
+                if (len >= rst)
+                    continue;
+                double w = 1 - len / rst;
+                sw += w;
+                sk += w * kin[j];
+            }
+            kout[i] = sk / sw;
+        }
+        double *t = kin;
+        kin = kout;
+        kout = t;
+    }
+    /* sigma kappa delta n. An unlike pair (i in x, j in y) adds
+     * -sigma_xy kappa_ij C phi r_hat_ij to both i and j, kappa_ij the mean of
+     * the curvature seen from x and minus the one seen from y: the two sides
+     * of an interface carry the same force, half the jump each (unequal
+     * shares pull one side off the other and open a gap). A free surface
+     * adds 2 sigma_x kappa_i C sum phi r_hat over the particles present. */
+    const double *kap = kin;
+#pragma omp parallel for schedule(dynamic, 64)
+    for (long i = 0; i < np; i++) {
+        if (isnan(kap[i]))
+            continue;
+        const int x = fluid_of(fid, (size_t)i);
+        const bool free_surface = d->fdir[3 * i] != 0;
+        double f[3] = {0, 0, 0}, r[3];
+        for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
+            size_t j = nl->j[k];
+            double len = dist(&p->pos[3 * i], &p->pos[3 * j], r);
+            if (len >= rst || len <= 0)
+                continue;
+            double s = colour_weight(len, rst) / len; /* phi(r) r_hat */
+            double coef = free_surface ? 2 * d->sigma[x][x] * kap[i] : 0.0;
+            if (!own(p, fid, j, x)) {
+                double kj = isnan(kap[j]) ? -kap[i] : kap[j];
+                coef -= d->sigma[x][fluid_of(fid, j)] * 0.5 * (kap[i] - kj);
+            }
+            for (int c = 0; c < 3; c++)
+                f[c] += coef * s * r[c];
+        }
+        const double rho = sim->fluid[x].rho;
+        for (int c = 0; c < 3; c++) {
+            accel_out[3 * i + c] = d->g_coef * f[c] / rho;
+            acc[3 * i + c] += accel_out[3 * i + c];
+        }
+        kappa_out[i] = kap[i];
+    }
+    return 0;
+}
+
+/* Brackbill et al. (1992): a capillary wave must not cross a particle in a
+ * step, dt <= sqrt(rho_bar l0^3 / (2 pi sigma)). */
+static double st_stable_dt(const st_data *d, const mf_sim *sim)
+{
+    double dt = INFINITY;
+    for (int x = 0; x < d->nfluids; x++)
+        for (int y = x; y < d->nfluids; y++) {
+            double sig = d->sigma[x][y];
+            if (!(sig > 0))
+                continue;
+            double rho = x == y ? sim->fluid[x].rho : 0.5 * (sim->fluid[x].rho + sim->fluid[y].rho);
+            double lim = d->s.dt_factor * sqrt(rho * pow(d->l0, 3) / (2 * M_PI * sig));
+            if (lim < dt)
+                dt = lim;
+        }
+    return dt;
+}
+
+double mf_forces_stable_dt(const mf_sim *sim)
+{
+    double dt = INFINITY;
+    for (size_t k = 0; k < sim->nforces; k++)
+        if (sim->forces[k].info == &mf_force_surfaceTension.info && sim->forces[k].data) {
+            double lim = st_stable_dt(sim->forces[k].data, sim);
+            if (lim < dt)
+                dt = lim;
+        }
+    return dt;
+}
+
+const mf_force_ops mf_force_surfaceTension = {
+    .info = {MF_ABI_VERSION, MF_KIND_FORCE, "surfaceTension",
+             "surface tension sigma kappa delta n, curvature from particle counts (Appendix A, "
+             "Nomura et al. 2001)",
+             st_params, ST_NPARAMS, sizeof(st_settings)},
+    .create = st_create,
+    .accumulate = st_accumulate,
+    .destroy = st_destroy,
+};

@@ -1,0 +1,117 @@
+/* mafl_step.c: one MPS-MAFL step, phase by phase (the paper's Algorithm 2). */
+#include <math.h>
+#include <string.h>
+
+#include "mafl.h"
+#include "mf_error.h"
+#include "mf_run.h"
+
+int mafl_cells_near(const mf_grid *g, const double x[3], long cells[27])
+{
+    if (g->ncells == 0)
+        return 0;
+    const double w = g->cell_size * (1.0 + MF_GRID_CELL_SLACK);
+    long lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    for (int a = 0; a < g->dim; a++) {
+        double u = floor((x[a] - g->origin[a]) / w);
+        if (!(u + 1 >= 0) || !(u - 1 < (double)g->nbox[a]))
+            return 0; /* more than a cell outside the box, or NaN */
+        long c = (long)u;
+        lo[a] = c - 1 < 0 ? 0 : c - 1;
+        hi[a] = c + 1 >= (long)g->nbox[a] ? (long)g->nbox[a] - 1 : c + 1;
+    }
+    int count = 0;
+    for (long iz = lo[2]; iz <= hi[2]; iz++)
+        for (long iy = lo[1]; iy <= hi[1]; iy++)
+            for (long ix = lo[0]; ix <= hi[0]; ix++) {
+                long c = mf_grid_find_cell(g, mf_grid_key((uint64_t)ix, (uint64_t)iy,
+                                                          (uint64_t)iz));
+                if (c >= 0)
+                    cells[count++] = c;
+            }
+    return count;
+}
+
+/* Keep r^n, u^n and the kinds in fields (the MPS step may reorder the
+ * particles); inlet and outlet points join the Lagrangian motion as fluid,
+ * so that the fluid beside them is neither stretched nor squeezed. */
+static void save_start(mafl_data *d, mf_particles *p)
+{
+    double *xn = mf_particles_fd(p, d->f_pos_n), *un = mf_particles_fd(p, d->f_vel_n);
+    int32_t *kind0 = mf_particles_fi(p, d->f_kind);
+    memcpy(xn, p->pos, 3 * p->n * sizeof *xn);
+    memcpy(un, p->vel, 3 * p->n * sizeof *un);
+    for (size_t i = 0; i < p->n; i++) {
+        kind0[i] = p->kind[i];
+        if (p->kind[i] == MF_INLET || p->kind[i] == MF_OUTLET)
+            p->kind[i] = MF_FLUID;
+    }
+}
+
+static void restore_kinds(mafl_data *d, mf_particles *p)
+{
+    const int32_t *kind0 = mf_particles_fi(p, d->f_kind);
+    for (size_t i = 0; i < p->n; i++)
+        p->kind[i] = (uint8_t)kind0[i];
+}
+
+/* r^{n+1} and the convected values become the particles' state; inlet
+ * points keep their prescribed velocity. */
+static void commit(mafl_data *d, mf_sim *sim)
+{
+    mf_particles *p = sim->p;
+    const size_t n = p->n;
+    const int32_t *kind0 = mf_particles_fi(p, d->f_kind);
+    const double *un = mf_particles_fd(p, d->f_vel_n);
+    memcpy(p->pos, d->pos_new, 3 * n * sizeof *p->pos);
+    for (size_t i = 0; i < n; i++) {
+        if (kind0[i] == MF_INLET)
+            memcpy(&p->vel[3 * i], &un[3 * i], 3 * sizeof *un);
+        if (!d->convected[i])
+            continue;
+        for (int c = 0; c < sim->dim; c++)
+            p->vel[3 * i + c] = d->value[c * n + i];
+        for (int k = 0; k < d->nscalars; k++)
+            mf_particles_fd(p, d->f_scalar[k])[i] = d->value[(sim->dim + k) * n + i];
+    }
+}
+
+int mafl_step(mafl_data *d, mf_sim *sim, double dt)
+{
+    mf_particles *p = sim->p;
+    double t0 = mf_wall_seconds();
+    MF_CALL(mafl_reserve(d, p->n));
+
+    /* 1. Lagrangian phase: the MPS module's step. */
+    save_start(d, p);
+    int rc = mafl_lagrangian(d, sim, dt);
+    restore_kinds(d, p);
+    MF_CALL(rc);
+    double t1 = mf_wall_seconds();
+    d->t_lagrangian += t1 - t0;
+
+    /* 2. Reconfiguration: r^{n+1}, u^c, u^a, with neighbours at r^L. */
+    memcpy(d->pos_l, p->pos, 3 * p->n * sizeof *d->pos_l);
+    double cell = d->s.re_interpolation;
+    if (d->s.mps.re_gradient > cell)
+        cell = d->s.mps.re_gradient;
+    if (cell < 1.5)
+        cell = 1.5;
+    MF_CALL(mf_grid_build(&d->grid, p, cell * sim->l0));
+    MF_CALL(mafl_reconfigure(d, sim, dt));
+    double t2 = mf_wall_seconds();
+    d->t_reconfigure += t2 - t1;
+
+    /* 3. Eulerian phase: every carried field to r^{n+1}. */
+    MF_CALL(mafl_eulerian(d, sim, dt));
+    commit(d, sim);
+    double t3 = mf_wall_seconds();
+    d->t_eulerian += t3 - t2;
+
+    /* 4. Where the number of points changes (eq. 22). */
+    MF_CALL(mafl_update_points(d, sim));
+    d->t_points += mf_wall_seconds() - t3;
+    mf_log_printf(sim->log, MF_LOG_STEP, "MAFL: points added %zu, removed %zu; max q %.3g\n",
+                  d->last_added, d->last_removed, d->q_max);
+    return 0;
+}

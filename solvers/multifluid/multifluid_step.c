@@ -1,0 +1,76 @@
+/* multifluid_step.c: one multi-fluid step (section 3.4), phase by phase,
+ * through the MPS phases with a density and viscosity per particle. */
+#include <math.h>
+
+#include "mf_error.h"
+#include "multifluid.h"
+
+/* Density and viscosity per particle from FluidId. A wall takes the
+ * w-weighted mean density of its fluid neighbours (the heaviest fluid's
+ * when it has none), so that a wall under water is water to the PPE and a
+ * wall in air is air; its viscosity is not used (a wall takes that of the
+ * fluid particle it touches). rho_light: every heavy particle as the
+ * lightest fluid (the first solve of the iterative pressure). */
+void multifluid_fill_properties(multifluid_data *d, const mf_sim *sim)
+{
+    const mf_particles *p = sim->p;
+    const int32_t *fid = mf_particles_fi(p, d->f_fluid);
+    const mf_nlist *nl = &d->mps->nl_max;
+    const double re = nl->radius;
+    for (size_t i = 0; i < p->n; i++) {
+        if (p->kind[i] == MF_FLUID) {
+            const mf_fluid *f = &sim->fluid[fid[i]];
+            d->rho[i] = f->rho;
+            d->mu[i] = f->rho * f->nu;
+            d->rho_light[i] = d->heavy[fid[i]] ? d->rho_min : f->rho;
+            continue;
+        }
+        double sw = 0, swr = 0;
+        if (i < nl->n)
+            for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
+                size_t j = nl->j[k];
+                if (p->kind[j] != MF_FLUID)
+                    continue;
+                double r2 = 0;
+                for (int c = 0; c < 3; c++) {
+                    double dx = p->pos[3 * j + c] - p->pos[3 * i + c];
+                    r2 += dx * dx;
+                }
+                double w = mf_weight(sqrt(r2), re);
+                sw += w;
+                swr += w * sim->fluid[fid[j]].rho;
+            }
+        d->rho[i] = sw > 0 ? swr / sw : d->rho_max;
+        d->mu[i] = 0;
+        /* In the light solve every particle is light: the wall's fluid
+         * neighbours are, so is the wall. */
+        d->rho_light[i] = d->iterative ? fmin(d->rho[i], d->rho_min) : d->rho[i];
+    }
+}
+
+int multifluid_step(multifluid_data *d, mf_sim *sim, double dt)
+{
+    mps_data *m = d->mps;
+    if (d->f_fluid < 0) { /* one fluid: the MPS step itself */
+        MF_CALL(mps_lagrangian_step(m, sim, dt));
+        return 0;
+    }
+    mf_particles *p = sim->p;
+    MF_CALL(mps_reserve(m, p->n));
+    MF_CALL(multifluid_reserve(d, p->n));
+    MF_CALL(mps_build_neighbours(m, sim, true)); /* at r^n; may reorder the particles */
+    mps_set_masks(m, p);
+    multifluid_fill_properties(d, sim);
+    m->rho = d->rho;
+    m->mu = d->mu;
+    m->p_dirichlet = NULL;
+    MF_CALL(mps_explicit_phase(m, sim, dt));      /* eq. 27 */
+    MF_CALL(mps_build_neighbours(m, sim, false)); /* at r* */
+    if (d->iterative) {
+        MF_CALL(multifluid_iterative_pressure(d, sim, dt));
+        return 0;
+    }
+    MF_CALL(mps_pressure_phase(m, sim, dt));   /* variable-density PPE, one solve */
+    MF_CALL(mps_correction_phase(m, sim, dt)); /* with 1/rho_ij */
+    return 0;
+}
