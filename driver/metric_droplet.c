@@ -644,9 +644,10 @@ static int rt_evaluate(const char *case_dir, const mf_dict *md, double *error)
                  s.heavy, s.light, e0, e_end, e_min, *error);
         snprintf(title, sizeof title, "Rayleigh-Taylor (potential energy left %.3g)", *error);
         mf_plot plot = {title, "t, s", "height, m", false, false, NULL};
-        mf_series series[3] = {{"spike (heavy, lowest)", t.col[0], t.col[1], t.n, "lines lw 2", NULL},
-                               {"bubble (light, highest)", t.col[0], t.col[2], t.n, "lines lw 2", NULL},
-                               {"heavy mean height", t.col[0], t.col[3], t.n, "lines", NULL}};
+        mf_series series[3] = {
+            {"spike (heavy, lowest)", t.col[0], t.col[1], t.n, "lines lw 2", NULL},
+            {"bubble (light, highest)", t.col[0], t.col[2], t.n, "lines lw 2", NULL},
+            {"heavy mean height", t.col[0], t.col[3], t.n, "lines", NULL}};
         rc = write_report(case_dir, comment, "t,spike,bubble,heavy_mean_height", &t, &plot,
                           series, 3);
     }

@@ -1,48 +1,52 @@
 /* surface_tension.c: the surface tension force of the paper's Appendix A
  * (after Nomura et al. 2001), eq. 33's sigma kappa delta n per unit volume,
- * returned as the acceleration f_st / rho_x of eq. 27.
+ * returned as the acceleration f_st / rho_x of eq. 27 (and written to the
+ * SurfaceTension field; the curvature to Curvature).
  *
  * Interface particles. A fluid particle of fluid x is on an interface when a
- * particle of another fluid lies within r_st, or (free surface) when fewer
- * particles of any kind than beta N_full lie within r_st, N_full being the
- * count of a full lattice (a free surface counts only where the fluid's
- * sigma > 0). Walls and dummies count as the particle's own fluid (no
- * contact-angle model).
+ * particle of another fluid lies within r_st, or (a free surface, where
+ * sigma_x > 0) when fewer than beta N_full particles of any kind lie within
+ * r_st, N_full the count of a full neighbourhood in the current packing.
+ * Walls and dummies count as the particle's own fluid (no contact-angle
+ * model).
  *
- * Curvature (eqs. 34-39). n^st1_i counts the own-fluid particles within r_st
- * (eqs. 34-35, w = 1 inside r_st); n^st2_i counts only those deeper inside
- * than i, n^st1_j > n^st1_i (eqs. 36-37), a tie counting one half so that
- * a particle's own layer is neither in nor out whatever the disorder; walls
- * count as deeper. n0^st is n^st2 at a flat interface (kappa = 0), computed
- * on the lattice the same way (it comes out N_full / 2). With the fraction
- * f = n^st2 / (2 n0^st) of the r_st disk (ball) that the fluid fills:
- *   curvature paper: 2 theta = pi n^st2 / n0^st, kappa = 2 cos(theta) / r_st
- *                    (eqs. 38-39; they take the fluid's part of the disk as
- *                    the sector of angle 2 theta);
- *   curvature exact (default): f inverted through the exact area of a disk
- *                    of radius r_st centred on a circle of radius R (2-D),
- *                    or the volume of a ball centred on a sphere (3-D,
- *                    f = 1/2 - 3 r_st / (16 R), kappa = 2/R, the sum of the
- *                    principal curvatures, so that dp = sigma kappa gives
- *                    Laplace's 2 sigma / R).
- * Why exact by default: the sector leaves out the two segments between the
- * chords and the arc, so that f = 1/2 - r_st/(3 pi R) + ... where the
- * sector gives 1/2 - r_st/(2 pi R): eqs. 38-39 return 2/3 of the curvature
- * (measured on lattice droplets: 0.68 of 1/R at R = 10-40 l0, against 1.02
- * to 1.07 with the exact area; README, "Multi-fluid").
+ * Counts (eqs. 34-37). n^st1_i counts the own-fluid particles within r_st
+ * (w = 1 inside r_st); n^st2_i only those deeper inside than i,
+ * n^st1_j > n^st1_i, a tie counting one half (the particle's own layer is
+ * neither in nor out whatever the disorder); walls count as deeper. n0^st
+ * is n^st2 at a flat interface (kappa = 0): on the lattice it is N_full / 2,
+ * and N_full is measured on the deep particles of the current packing
+ * (disorder changes it by a particle or two). Where the probe is full (an
+ * interface between fluids) the particle's own count of every particle
+ * stands for N_full.
  *
- * delta n (eq. 33). The interface normal and delta come from the gradient of
- * the colour C_x (1 in fluid x, 0 elsewhere) with the MPS gradient (eq. 5)
- * and weight (eq. 3) of radius r_st:
- *   another fluid y:  g^y_i = -(d/n0) sum_{j in y} r_ij w_ij / |r_ij|^2,
- *   free surface:     g^0_i = (d/n0) sum_{j present} r_ij w_ij / |r_ij|^2
- *                     (the missing neighbours' share of the same sum).
- * Across a flat interface the sum of g over a column of particles is half
- * the jump of C on each side (exactly so for the lattice: (d/n0) sum_j
- * r_y^2 w / r^2 = 1, half from each side), so each side of a fluid/fluid
- * interface takes sigma_xy kappa_i g^y_i and a free surface, which has one
- * side, takes 2 sigma_x kappa_i g^0_i. The force per unit volume integrated
- * across the interface is then sigma kappa: the pressure jump is Laplace's.
+ * Curvature, with f = n^st2 / (2 n0^st) the fraction of the r_st disk
+ * (ball) the fluid fills:
+ *   paper:  eqs. 38-39, 2 theta = pi n^st2 / n0^st, kappa = 2 cos(theta)/r_st.
+ *           They take the fluid's part of the disk as the sector of angle
+ *           2 theta and leave out the two segments between the chords and
+ *           the arc: f = 1/2 - r_st/(3 pi R) where the sector gives
+ *           1/2 - r_st/(2 pi R), so kappa comes out 2/3 of 1/R.
+ *   exact:  f inverted through the exact area of a disk of radius r_st
+ *           centred on a circle of radius R (2-D), or the volume of a ball
+ *           centred on a sphere (3-D, f = 1/2 - 3 r_st/(16 R), kappa = 2/R,
+ *           the sum of the principal curvatures: dp = sigma kappa is
+ *           Laplace's 2 sigma/R). Right on a lattice drop, but the counts
+ *           follow the particle density: in motion a few per cent of
+ *           compression at the interface reads as a curvature of 1/R.
+ *   normal: (default) kappa = div n, n the outward unit normal of the colour
+ *           gradient (Brackbill et al. 1992): insensitive to the density.
+ * (README, "Multi-fluid", has the measurements.)
+ *
+ * delta n (eq. 33). The colour C_x (1 in fluid x, 0 elsewhere) has the
+ * gradient g^y_i = -C sum_{j in y} phi(r_ij) r_hat_ij toward another fluid
+ * y and g^0_i = C sum_{j present} phi r_hat (the missing neighbours' share)
+ * toward the void, phi = (1 - r/r_st)^2, C = d / sum_lattice r phi(r): across
+ * a flat interface the sum of g over a column of particles is half the jump
+ * of C on each side. So each side of a fluid/fluid interface takes
+ * sigma_xy kappa g^y (kappa the pair's mean curvature: the two sides carry
+ * equal shares) and a free surface, which has one side, 2 sigma_x kappa g^0.
+ * The force per unit volume integrated across the interface is sigma kappa.
  *
  * Tension of a pair: sigma_xy of an `interfaces` entry, else Antonow's rule
  * |sigma_x - sigma_y| (a fluid against one with sigma 0 keeps its own
