@@ -316,7 +316,10 @@ double ls_field_at(const ls_field *f, int32_t cand, int32_t x, int32_t y, int32_
 }
 
 /* Values at (x0 + s i, y0 + s j, z0 + s k), i, j, k in [0, n), x fastest.
- * The row filter keeps the candidates whose support meets the row. */
+ * Each candidate is first sorted into the rows (j, k) its support meets
+ * (a counting sort), so a row only visits the particles that reach it and,
+ * of those, only the points within their x extent. */
+#define MAX_N 9
 static void eval_block(const ls_field *f, int32_t cand, int32_t x0, int32_t y0, int32_t z0,
                        int n, int s, float *out)
 {
@@ -327,27 +330,67 @@ static void eval_block(const ls_field *f, int32_t cand, int32_t x0, int32_t y0, 
         return;
     }
     const size_t c0 = f->start[cand], nc = f->start[cand + 1] - c0;
-    uint32_t row_stack[1024];
-    uint32_t *row = nc <= 1024 ? row_stack : malloc(nc * sizeof *row);
-    double acc[64];
+    const double inv_s = 1.0 / s;
+    size_t count[MAX_N * MAX_N + 1] = {0};
+    /* pass 1: the row ranges of each candidate, and the row counts */
+    int16_t range_stack[4 * 512];
+    int16_t *range = nc <= 512 ? range_stack : malloc(4 * nc * sizeof *range);
+    uint32_t list_stack[8192];
+    uint32_t *list = NULL;
+    size_t total = 0;
+    if (range) {
+        for (size_t q = 0; q < nc; q++) {
+            const uint32_t i = f->list[c0 + q];
+            double jl = ceil((f->y[i] - f->ey[i] - y0) * inv_s),
+                   jh = floor((f->y[i] + f->ey[i] - y0) * inv_s),
+                   kl = ceil((f->z[i] - f->ez[i] - z0) * inv_s),
+                   kh = floor((f->z[i] + f->ez[i] - z0) * inv_s);
+            int16_t *r = &range[4 * q];
+            r[0] = (int16_t)(jl < 0 ? 0 : jl);
+            r[1] = (int16_t)(jh > n - 1 ? n - 1 : jh);
+            r[2] = (int16_t)(kl < 0 ? 0 : kl);
+            r[3] = (int16_t)(kh > n - 1 ? n - 1 : kh);
+            for (int k = r[2]; k <= r[3]; k++)
+                for (int j = r[0]; j <= r[1]; j++) {
+                    count[j + n * k + 1]++;
+                    total++;
+                }
+        }
+        list = total <= 8192 ? list_stack : malloc(total * sizeof *list);
+    }
+    if (!list) {
+        /* no memory for the row lists: slow but correct */
+        if (range != range_stack)
+            free(range);
+        for (int k = 0; k < n; k++)
+            for (int j = 0; j < n; j++)
+                for (int i = 0; i < n; i++)
+                    out[i + n * (j + n * k)] =
+                        (float)ls_field_at(f, cand, x0 + s * i, y0 + s * j, z0 + s * k);
+        return;
+    }
+    for (int r = 0; r < n * n; r++)
+        count[r + 1] += count[r];
+    size_t fill[MAX_N * MAX_N];
+    memcpy(fill, count, (size_t)n * n * sizeof *fill);
+    for (size_t q = 0; q < nc; q++) {
+        const int16_t *r = &range[4 * q];
+        for (int k = r[2]; k <= r[3]; k++)
+            for (int j = r[0]; j <= r[1]; j++)
+                list[fill[j + n * k]++] = f->list[c0 + q];
+    }
+    /* pass 2: each row */
+    double acc[MAX_N];
     for (int k = 0; k < n; k++)
         for (int j = 0; j < n; j++) {
             const double py = y0 + s * j, pz = z0 + s * k;
-            size_t nr = 0;
-            if (row) {
-                for (size_t q = 0; q < nc; q++) {
-                    uint32_t i = f->list[c0 + q];
-                    if (fabs(py - f->y[i]) < f->ey[i] && fabs(pz - f->z[i]) < f->ez[i])
-                        row[nr++] = i;
-                }
-            }
             for (int i = 0; i < n; i++)
                 acc[i] = 0;
-            for (size_t q = 0; q < nr; q++) {
-                const uint32_t i = row[q];
+            const size_t r = (size_t)(j + n * k);
+            for (size_t q = count[r]; q < count[r + 1]; q++) {
+                const uint32_t i = list[q];
                 const double dy = py - f->y[i], dz = pz - f->z[i];
-                /* the points of the row within the support's x extent */
-                double lo = (f->x[i] - f->ex[i] - x0) / s, hi = (f->x[i] + f->ex[i] - x0) / s;
+                double lo = (f->x[i] - f->ex[i] - x0) * inv_s, hi = (f->x[i] + f->ex[i] - x0) * inv_s;
                 int a = lo < 0 ? 0 : (int)ceil(lo), b = hi >= n ? n - 1 : (int)floor(hi);
                 for (int ii = a; ii <= b; ii++) {
                     const double dx = x0 + s * ii - f->x[i];
@@ -359,12 +402,11 @@ static void eval_block(const ls_field *f, int32_t cand, int32_t x0, int32_t y0, 
             float *o = out + (size_t)n * (j + (size_t)n * k);
             for (int i = 0; i < n; i++)
                 o[i] = (float)(f->offset + acc[i]);
-            if (!row) /* no memory for the filter: slow but correct */
-                for (int i = 0; i < n; i++)
-                    o[i] = (float)ls_field_at(f, cand, x0 + s * i, y0 + s * j, z0 + s * k);
         }
-    if (row != row_stack)
-        free(row);
+    if (range != range_stack)
+        free(range);
+    if (list != list_stack)
+        free(list);
 }
 
 void ls_field_brick(const ls_field *f, int32_t bx, int32_t by, int32_t bz, int n, float *out)

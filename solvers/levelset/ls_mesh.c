@@ -29,7 +29,13 @@ typedef struct src {
     const float *v32;
     const double *v64;
     const uint8_t *known;
+    /* the current brick's values with a halo, local -1 .. 9 (NaN: unknown) */
+    const double *pad;
+    int32_t pad_brick;
 } src;
+
+#define Q 11
+#define QI(i, j, k) ((i) + 1 + Q * ((j) + 1 + Q * ((k) + 1)))
 
 /* Brick and local offset of a point given relative to brick b, coordinates
  * in [-8, 15]. */
@@ -46,11 +52,23 @@ static inline bool locate(const src *s, int32_t b, int i, int j, int k, size_t *
 
 static inline bool value(const src *s, int32_t b, int i, int j, int k, double *v)
 {
+    if (s->pad && b == s->pad_brick && i >= -1 && i <= 9 && j >= -1 && j <= 9 && k >= -1 &&
+        k <= 9) {
+        *v = s->pad[QI(i, j, k)];
+        return !isnan(*v);
+    }
     size_t o;
     if (!locate(s, b, i, j, k, &o))
         return false;
     *v = s->v32 ? (double)s->v32[o] : s->v64[o];
     return true;
+}
+
+static inline int popcount8(unsigned m)
+{
+    m = m - ((m >> 1) & 0x55);
+    m = (m & 0x33) + ((m >> 2) & 0x33);
+    return (int)((m + (m >> 4)) & 0x0f);
 }
 
 static inline int dir_x(int d) { return d & 1; }
@@ -85,6 +103,21 @@ static void gradient(const src *s, int32_t b, int i, int j, int k, double g[3])
     }
 }
 
+/* A per-thread view of the source with brick b's padded block filled. */
+static void with_pad(const src *s, int32_t b, double *pad, src *out)
+{
+    *out = *s;
+    out->pad = NULL;
+    for (int k = -1; k <= 9; k++)
+        for (int j = -1; j <= 9; j++)
+            for (int i = -1; i <= 9; i++) {
+                double v;
+                pad[QI(i, j, k)] = value(out, b, i, j, k, &v) ? v : NAN;
+            }
+    out->pad = pad;
+    out->pad_brick = b;
+}
+
 /* Kuhn split: tetrahedra {0, a, a | b, 7} for the 6 orders of the axes
  * (corner codes: bit 0 x, bit 1 y, bit 2 z). */
 static const int tets[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7},
@@ -108,7 +141,7 @@ static inline int32_t vertex_of(const src *s, const counts *c, int32_t b, int i,
     if (!(m & (1u << d)))
         return -1;
     return (int32_t)(c->voff[brick] + c->cum[o] +
-                     (size_t)__builtin_popcount(m & ((1u << d) - 1)));
+                     (size_t)popcount8(m & ((1u << d) - 1)));
 }
 
 /* The triangles of one tetrahedron (corner values v, positions on the
@@ -274,7 +307,7 @@ static size_t brick_triangles(const src *s, const counts *c, int32_t b, int32_t 
 int ls_mesh_extract(const ls_bricks *bricks, const int32_t *nb, const float *values32,
                     const double *values64, const uint8_t *known, double h, mf_mesh *out)
 {
-    src s = {bricks, nb, values32, values64, known};
+    src s = {bricks, nb, values32, values64, known, NULL, LS_NONE};
     const size_t nbk = bricks->n;
     counts c = {0};
     c.mask = malloc((nbk ? nbk : 1) * LS_B3);
@@ -289,21 +322,24 @@ int ls_mesh_extract(const ls_bricks *bricks, const int32_t *nb, const float *val
     /* 1. crossing edges per point, vertex numbering */
 #pragma omp parallel for schedule(dynamic, 8)
     for (size_t b = 0; b < nbk; b++) {
+        double pad[Q * Q * Q];
+        src ps;
+        with_pad(&s, (int32_t)b, pad, &ps);
         size_t total = 0;
         for (int l = 0; l < LS_B3; l++) {
             const int i = l & 7, j = (l >> 3) & 7, k = l >> 6;
             const size_t o = b * LS_B3 + (size_t)l;
             unsigned m = 0;
             double v0 = 0, v1 = 0;
-            if (value(&s, (int32_t)b, i, j, k, &v0)) {
+            if (value(&ps, (int32_t)b, i, j, k, &v0)) {
                 for (int d = 1; d < 8; d++)
-                    if (value(&s, (int32_t)b, i + dir_x(d), j + dir_y(d), k + dir_z(d), &v1) &&
+                    if (value(&ps, (int32_t)b, i + dir_x(d), j + dir_y(d), k + dir_z(d), &v1) &&
                         (v0 > 0) != (v1 > 0))
                         m |= 1u << d;
             }
             c.mask[o] = (uint8_t)m;
             c.cum[o] = (uint16_t)total;
-            total += (size_t)__builtin_popcount(m);
+            total += (size_t)popcount8(m);
         }
         c.voff[b + 1] = total;
     }
@@ -313,8 +349,12 @@ int ls_mesh_extract(const ls_bricks *bricks, const int32_t *nb, const float *val
     /* 2. triangles per brick */
     int bad = 0;
 #pragma omp parallel for schedule(dynamic, 8) reduction(| : bad)
-    for (size_t b = 0; b < nbk; b++)
-        c.toff[b + 1] = brick_triangles(&s, &c, (int32_t)b, NULL, &bad);
+    for (size_t b = 0; b < nbk; b++) {
+        double pad[Q * Q * Q];
+        src ps;
+        with_pad(&s, (int32_t)b, pad, &ps);
+        c.toff[b + 1] = brick_triangles(&ps, &c, (int32_t)b, NULL, &bad);
+    }
     c.toff[0] = 0;
     for (size_t b = 0; b < nbk; b++)
         c.toff[b + 1] += c.toff[b];
@@ -331,6 +371,9 @@ int ls_mesh_extract(const ls_bricks *bricks, const int32_t *nb, const float *val
 #pragma omp parallel for schedule(dynamic, 8) reduction(| : bad)
     for (size_t b = 0; b < nbk; b++) {
         const int32_t *bc = &bricks->coord[3 * b];
+        double pad[Q * Q * Q];
+        src ps;
+        with_pad(&s, (int32_t)b, pad, &ps);
         for (int l = 0; l < LS_B3; l++) {
             const size_t o = b * LS_B3 + (size_t)l;
             unsigned m = c.mask[o];
@@ -338,15 +381,15 @@ int ls_mesh_extract(const ls_bricks *bricks, const int32_t *nb, const float *val
                 continue;
             const int i = l & 7, j = (l >> 3) & 7, k = l >> 6;
             double v0 = 0, v1 = 0, g0[3], g1[3];
-            value(&s, (int32_t)b, i, j, k, &v0);
-            gradient(&s, (int32_t)b, i, j, k, g0);
+            value(&ps, (int32_t)b, i, j, k, &v0);
+            gradient(&ps, (int32_t)b, i, j, k, g0);
             size_t vi = c.voff[b] + c.cum[o];
             for (int d = 1; d < 8; d++) {
                 if (!(m & (1u << d)))
                     continue;
                 const int i1 = i + dir_x(d), j1 = j + dir_y(d), k1 = k + dir_z(d);
-                value(&s, (int32_t)b, i1, j1, k1, &v1);
-                gradient(&s, (int32_t)b, i1, j1, k1, g1);
+                value(&ps, (int32_t)b, i1, j1, k1, &v1);
+                gradient(&ps, (int32_t)b, i1, j1, k1, g1);
                 const double t = crossing(v0, v1);
                 float *x = &out->xyz[3 * vi], *n = &out->normal[3 * vi];
                 x[0] = (float)(h * (LS_B * bc[0] + i + t * dir_x(d)));
@@ -371,7 +414,7 @@ int ls_mesh_extract(const ls_bricks *bricks, const int32_t *nb, const float *val
                 vi++;
             }
         }
-        brick_triangles(&s, &c, (int32_t)b, out->tri + 3 * c.toff[b], &bad);
+        brick_triangles(&ps, &c, (int32_t)b, out->tri + 3 * c.toff[b], &bad);
     }
     if (bad)
         rc = MF_ERROR(MF_ERR_INTERNAL, "marching tetrahedra: a crossing edge without a vertex");

@@ -28,6 +28,9 @@
 #define FH 4
 #define FP (LS_B + 2 * FH)
 #define FPI(i, j, k) ((i) + FH + FP * ((j) + FH + FP * ((k) + FH)))
+#ifndef CURV_BOUND
+#define CURV_BOUND 3.0
+#endif
 #define MIN(a, b) ((a) < (b) ? (a) : (b))
 #define MAX(a, b) ((a) > (b) ? (a) : (b))
 
@@ -341,6 +344,6 @@ double ls_rhs_stable_step(const ls_rhs *r, bool curvature)
      * sqrt(3) |V|; the curvature term behaves as (beta'/2) times a Laplacian,
      * whose largest eigenvalue is 6 beta' in 3-D, so dtau <= 2 / (6 beta'). */
     double adv = sqrt(3.0) * r->alpha * (r->fmax > 0.1 ? r->fmax : 0.1);
-    double curv = curvature ? 3.0 * r->beta_grid : 0.0;
+    double curv = curvature ? CURV_BOUND * r->beta_grid : 0.0;
     return 1.0 / (adv + curv);
 }
