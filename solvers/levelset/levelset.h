@@ -16,7 +16,8 @@
  *   ls_field.c          the particles' field F (eqs. 30-32) and the blobby field
  *   ls_detect.c         which bricks the zero level of a field crosses
  *   ls_band.c           the narrow band: seeds, fast marching, active points
- *   ls_rhs.c            the right-hand side of eq. 29 (upwind + curvature)
+ *   ls_rhs.c            the right-hand side of eq. 29 (upwind + curvature), and the
+ *                       preconditioner of the implicit curvature (IMEX)
  *   ls_arkode.c         ARKODE glue: ERKStep / ARKStep + SPGMR, statistics
  *   ls_mesh.c           marching tetrahedra with normals from grad phi
  *   ls_mesh_check.c     topology of a mesh (closed, manifold, Euler characteristic)
@@ -50,9 +51,9 @@ typedef struct ls_settings {
     double cutoff;         /* support of the (tapered) kernel, in l0 */
     long kernel_power;     /* k of eq. 31 */
     double threshold;      /* T of eq. 30 */
-    bool anisotropic;      /* eq. 32 */
+    bool anisotropic;      /* eq. 32 (off by default: README, "Surface") */
     double alpha, beta;    /* eq. 29 */
-    const char *integrator; /* "explicit" (ERKStep) or "imex" (ARKStep, SPGMR) */
+    const char *integrator; /* "explicit" (ERKStep) or "imex" (ARKStep, SPGMR); read at create */
     double tolerance;      /* converged: |d phi / d tau| on the surface below this, cells */
     double rel_tol, abs_tol; /* ARKODE's local error tolerances */
     long max_steps;        /* ARKODE steps per frame */
@@ -160,8 +161,6 @@ typedef struct ls_field {
     size_t *start;         /* touched.n + 1 */
     uint32_t *list;
     size_t cap_list, cap_start;
-    double seconds;        /* time spent evaluating */
-    size_t evaluations;    /* points evaluated */
 } ls_field;
 
 void ls_field_init(ls_field *f);
@@ -264,6 +263,8 @@ typedef struct ls_rhs {
     int32_t *padof;        /* per brick: its padded block, or -1 (no active point) */
     double *pad;           /* 10^3 per padded brick: the brick and a one-point halo */
     float *Fpad;           /* 16^3 per padded brick: F with a four-point halo */
+    uint8_t *edge;         /* per active point: a stencil neighbour is beyond the rim */
+    double far_F;          /* F where no particle reaches (T) */
     float *pn;             /* preconditioner: normals at the active points */
     double *zpad;          /* preconditioner: padded correction */
     double pgamma;

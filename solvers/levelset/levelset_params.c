@@ -20,7 +20,10 @@ const mf_param ls_params[LS_NPARAMS] = {
      "k of eq. 31 (the paper: k = 1 oversmooths, k > 2 interpolates too little)"},
     {"threshold", MF_PARAM_SCALAR, "-2", -100, -1e-9, NULL, offsetof(ls_settings, threshold),
      "T of eq. 30, negative: the surface is where the kernel sum reaches -T"},
-    {"anisotropic", MF_PARAM_BOOL, "yes", MF_NO_RANGE, NULL, offsetof(ls_settings, anisotropic),
+    /* Off by default: as reconstructed, eq. 32 shrinks a fast particle's
+     * support to 1/(1 + s) of its volume, and fast fluid falls below T
+     * (README, "Surface"). */
+    {"anisotropic", MF_PARAM_BOOL, "no", MF_NO_RANGE, NULL, offsetof(ls_settings, anisotropic),
      "stretch each particle's distance along its velocity and shrink it across (eq. 32)"},
     {"alpha", MF_PARAM_SCALAR, "1", 0, 100, NULL, offsetof(ls_settings, alpha),
      "weight of F in eq. 29"},
@@ -30,7 +33,7 @@ const mf_param ls_params[LS_NPARAMS] = {
      offsetof(ls_settings, integrator),
      "pseudo-time integration: explicit (ARKODE ERKStep) or imex (ARKStep, curvature implicit, "
      "SPGMR)"},
-    {"tolerance", MF_PARAM_SCALAR, "0.01", 1e-8, 10, NULL, offsetof(ls_settings, tolerance),
+    {"tolerance", MF_PARAM_SCALAR, "0.03", 1e-8, 10, NULL, offsetof(ls_settings, tolerance),
      "converged when |d phi / d tau| within a cell of the surface falls below this (cells per "
      "unit pseudo-time)"},
     {"relTol", MF_PARAM_SCALAR, "1e-3", 1e-10, 1, NULL, offsetof(ls_settings, rel_tol),
@@ -39,7 +42,7 @@ const mf_param ls_params[LS_NPARAMS] = {
      "ARKODE absolute tolerance of the pseudo-time steps, grid cells"},
     {"maxSteps", MF_PARAM_INT, "20000", 1, 1e9, NULL, offsetof(ls_settings, max_steps),
      "ARKODE steps per frame at most"},
-    {"maxPseudoTime", MF_PARAM_SCALAR, "200", 0.5, 1e9, NULL,
+    {"maxPseudoTime", MF_PARAM_SCALAR, "50", 0.5, 1e9, NULL,
      offsetof(ls_settings, max_pseudo_time), "pseudo-time per frame at most"},
     {"bandWidth", MF_PARAM_INT, "3", 2, 6, NULL, offsetof(ls_settings, band_width),
      "half-width of the evolved narrow band, cells"},

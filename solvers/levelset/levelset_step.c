@@ -110,7 +110,7 @@ static void log_frame(const ls_data *d, const mf_sim *sim, double h, const ls_fi
                   ls_band_memory(band) / 1048576.0, st->rebuilds);
     if (d->imex)
         mf_log_printf(log, MF_LOG_NORMAL,
-                      "levelSet ARKStep (IMEX ARK3(2)4L[2]SA, curvature implicit, SPGMR): %ld "
+                      "levelSet ARKStep (IMEX Euler ARS(1,1,1), curvature implicit, SPGMR): %ld "
                       "steps (%ld stability-limited, %ld accuracy-limited), %ld error-test "
                       "failures; right-hand sides %ld explicit + %ld implicit + %ld in "
                       "Jacobian-vector products; Newton iterations %ld (%ld failed), SPGMR "

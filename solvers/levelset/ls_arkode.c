@@ -289,7 +289,8 @@ int ls_evolve(ls_band *band, const ls_field *f, const ls_evolve_opts *o, ls_stat
         if (rc != 0 || band->nact == 0)
             break;
         const size_t n = band->nact;
-        ls_rhs r = {.band = band, .alpha = o->alpha, .beta_grid = o->beta_grid};
+        ls_rhs r = {.band = band, .alpha = o->alpha, .beta_grid = o->beta_grid,
+                    .far_F = f->offset};
         integrator it = {0};
         double *ybuild = malloc(n * sizeof *ybuild), *yprev = malloc(n * sizeof *yprev);
         N_Vector y = N_VNew_Serial((sunindextype)n, ctx);
@@ -309,7 +310,7 @@ int ls_evolve(ls_band *band, const ls_field *f, const ls_evolve_opts *o, ls_stat
             rc = integrator_create(&it, o, &r, y, ctx, &err);
         }
         bool rebuild_now = false;
-        double t = 0, step_factor = 1, last_rate = INFINITY;
+        double t = 0, step_factor = 1, best_rate = INFINITY;
         int stalled = 0;
         while (rc == 0 && !done && !rebuild_now) {
             double tret, tout = t + CHUNK;
@@ -374,11 +375,13 @@ int ls_evolve(ls_band *band, const ls_field *f, const ls_evolve_opts *o, ls_stat
              * oscillation instead of the steady state: when the change stops
              * falling, halve the step. */
             if (it.fixed) {
-                stalled = change / dt > 0.8 * last_rate ? stalled + 1 : 0;
-                last_rate = change / dt;
-                if (stalled >= 4 && step_factor > 1.0 / 64) {
+                if (change / dt < 0.7 * best_rate) {
+                    best_rate = change / dt;
+                    stalled = 0;
+                } else if (++stalled >= 4 && step_factor > 1.0 / 64) {
                     step_factor *= 0.5;
                     stalled = 0;
+                    best_rate = change / dt;
                 }
             }
             if (st->last_change < o->tolerance) {

@@ -18,7 +18,6 @@
  * stored, so memory follows the surface. Time of the coarse pass follows the
  * volume at the coarse spacing (the fine work follows the surface). */
 #include <math.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -224,8 +223,6 @@ int ls_detect(const ls_field *f, double l0, size_t mem_limit, ls_crossing *out)
         free(keep);
     }
     bool force = false;
-    if (getenv("LS_DEBUG"))
-        fprintf(stderr, "detect: stride %d, %zu touched bricks, %zu to the fine pass\n", s, nt, w.n);
     while (rc == 0 && w.n > 0) {
         next.n = 0;
         rc = fine_pass(f, &w, force, mem_limit, out, &next);

@@ -95,7 +95,7 @@ int ls_rhs_setup(ls_rhs *r)
                     int dbx = i < 0 ? -1 : (i >= LS_B ? 1 : 0), dby = j < 0 ? -1 : (j >= LS_B ? 1 : 0),
                         dbz = k < 0 ? -1 : (k >= LS_B ? 1 : 0);
                     int32_t nbk = band->nb[27 * b + (dbx + 1) + 3 * (dby + 1) + 9 * (dbz + 1)];
-                    float v = NAN;
+                    float v = (float)r->far_F; /* beyond the band: no particle reaches */
                     if (nbk != LS_NONE) {
                         size_t o = (size_t)nbk * LS_B3 + ls_local_index(i & 7, j & 7, k & 7);
                         if (band->flag[o] & LS_HAS_F)
@@ -103,6 +103,22 @@ int ls_rhs_setup(ls_rhs *r)
                     }
                     fp[FPI(i, j, k)] = v;
                 }
+    }
+    /* points whose stencil reaches past the rim */
+    r->edge = malloc((na ? na : 1) * sizeof *r->edge);
+    if (!r->edge)
+        return MF_ERROR(MF_ERR_MEMORY, "out of memory for the band's stencils");
+#pragma omp parallel for schedule(static)
+    for (size_t q = 0; q < na; q++) {
+        const int32_t b = (int32_t)(band->act[q] / LS_B3);
+        const int l = (int)(band->act[q] % LS_B3);
+        const double *c = r->pad + (size_t)r->padof[b] * P * P * P + PI(l & 7, (l >> 3) & 7, l >> 6);
+        bool e = false;
+        for (int dk = -1; dk <= 1; dk++)
+            for (int dj = -1; dj <= 1; dj++)
+                for (int di = -1; di <= 1; di++)
+                    e = e || isnan(c[di + P * (dj + P * dk)]);
+        r->edge[q] = e;
     }
     /* where each active value goes */
     r->slot_start[0] = 0;
@@ -148,6 +164,8 @@ void ls_rhs_free(ls_rhs *r)
     free(r->Fpad);
     free(r->pn);
     free(r->zpad);
+    free(r->edge);
+    r->edge = NULL;
     r->Fpad = NULL;
     r->pn = NULL;
     r->zpad = NULL;
@@ -169,6 +187,67 @@ static void scatter(ls_rhs *r, const double *y)
 
 static inline double sq(double x) { return x * x; }
 
+/* dphi/dtau at one point; c points at it in its padded block. `checked`:
+ * some stencil neighbour lies beyond the band's rim (NaN in the block) and
+ * takes the sign of the point with the rim's value. */
+static inline double point_rhs(const double *c, const float *fc, double alpha, double beta,
+                               int parts, bool checked, double fallback, double *fabs_out)
+{
+    const double p0 = c[0];
+    const double fb = copysign(fallback, p0);
+#define V(di, dj, dk)                                                                      \
+    (checked && isnan(c[(di) + P * ((dj) + P * (dk))]) ? fb : c[(di) + P * ((dj) + P * (dk))])
+    const double xm = V(-1, 0, 0), xp = V(1, 0, 0), ym = V(0, -1, 0), yp = V(0, 1, 0),
+                 zm = V(0, 0, -1), zp = V(0, 0, 1);
+    const double gx = 0.5 * (xp - xm), gy = 0.5 * (yp - ym), gz = 0.5 * (zp - zm);
+    const double g2 = gx * gx + gy * gy + gz * gz + 1e-12, ig2 = 1.0 / g2;
+    double out = 0;
+    if (parts & LS_RHS_ADVECTION) {
+        /* speed extended from the closest point of the zero level */
+        const double lim = FH - 1;
+        double ox = -p0 * gx * ig2, oy = -p0 * gy * ig2, oz = -p0 * gz * ig2;
+        ox = MAX(-lim, MIN(lim, ox));
+        oy = MAX(-lim, MIN(lim, oy));
+        oz = MAX(-lim, MIN(lim, oz));
+        /* floor of a value in [-lim, lim]: truncation of a shifted positive */
+        const int ix = (int)(ox + FH) - FH, iy = (int)(oy + FH) - FH, iz = (int)(oz + FH) - FH;
+        const double tx = ox - ix, ty = oy - iy, tz = oz - iz;
+        const float *f = fc + ix + FP * (iy + FP * iz);
+        const double f00 = f[0] + tx * (f[1] - f[0]), f10 = f[FP] + tx * (f[FP + 1] - f[FP]),
+                     f01 = f[FP * FP] + tx * (f[FP * FP + 1] - f[FP * FP]),
+                     f11 = f[FP * FP + FP] + tx * (f[FP * FP + FP + 1] - f[FP * FP + FP]);
+        const double f0 = f00 + ty * (f10 - f00), f1 = f01 + ty * (f11 - f01);
+        const double Fe = f0 + tz * (f1 - f0);
+        const double vel = alpha * Fe;
+        *fabs_out = fabs(Fe);
+        const double dmx = p0 - xm, dpx = xp - p0, dmy = p0 - ym, dpy = yp - p0, dmz = p0 - zm,
+                     dpz = zp - p0;
+        double up2;
+        if (vel > 0) /* front moves outward: information from inside */
+            up2 = sq(MIN(dmx, 0)) + sq(MAX(dpx, 0)) + sq(MIN(dmy, 0)) + sq(MAX(dpy, 0)) +
+                  sq(MIN(dmz, 0)) + sq(MAX(dpz, 0));
+        else
+            up2 = sq(MAX(dmx, 0)) + sq(MIN(dpx, 0)) + sq(MAX(dmy, 0)) + sq(MIN(dpy, 0)) +
+                  sq(MAX(dmz, 0)) + sq(MIN(dpz, 0));
+        out += vel * sqrt(up2);
+    }
+    if (parts & LS_RHS_CURVATURE) {
+        const double pxx = xp - 2 * p0 + xm, pyy = yp - 2 * p0 + ym, pzz = zp - 2 * p0 + zm;
+        const double pxy = 0.25 * (V(1, 1, 0) - V(1, -1, 0) - V(-1, 1, 0) + V(-1, -1, 0));
+        const double pxz = 0.25 * (V(1, 0, 1) - V(1, 0, -1) - V(-1, 0, 1) + V(-1, 0, -1));
+        const double pyz = 0.25 * (V(0, 1, 1) - V(0, 1, -1) - V(0, -1, 1) + V(0, -1, -1));
+        const double num = pxx * (gy * gy + gz * gz) + pyy * (gx * gx + gz * gz) +
+                           pzz * (gx * gx + gy * gy) -
+                           2 * (gx * gy * pxy + gx * gz * pxz + gy * gz * pyz);
+        const double gn = sqrt(g2);
+        double H = 0.5 * num * ig2 / gn; /* mean curvature, 1/cells */
+        H = H / (1.0 + fabs(H));         /* smooth clamp to a radius of a cell */
+        out += beta * H * gn;
+    }
+#undef V
+    return out;
+}
+
 void ls_rhs_eval(ls_rhs *r, const double *y, double *ydot, int parts)
 {
     const ls_band *band = r->band;
@@ -177,78 +256,23 @@ void ls_rhs_eval(ls_rhs *r, const double *y, double *ydot, int parts)
     const size_t nb = band->b.n;
     double fbig = 0;
     scatter(r, y);
-#pragma omp parallel reduction(max : fbig)
-    {
-#pragma omp for schedule(dynamic, 4)
-        for (size_t b = 0; b < nb; b++) {
-            const size_t a0 = r->bstart[b], a1 = r->bstart[b + 1];
-            if (a0 == a1)
-                continue;
-            const double *pad = r->pad + (size_t)r->padof[b] * P * P * P;
-            const float *fpad = r->Fpad + (size_t)r->padof[b] * FP * FP * FP;
-            for (size_t a = a0; a < a1; a++) {
-                const int l = (int)(band->act[a] % LS_B3);
-                const int i = l & 7, j = (l >> 3) & 7, k = l >> 6;
-                const double *c = &pad[PI(i, j, k)];
-                const double p0 = c[0];
-                const double fb = copysign(fallback, p0);
-#define V(di, dj, dk) (isnan(c[(di) + P * ((dj) + P * (dk))]) ? fb : c[(di) + P * ((dj) + P * (dk))])
-                const double xm = V(-1, 0, 0), xp = V(1, 0, 0), ym = V(0, -1, 0), yp = V(0, 1, 0),
-                             zm = V(0, 0, -1), zp = V(0, 0, 1);
-                const double gx = 0.5 * (xp - xm), gy = 0.5 * (yp - ym), gz = 0.5 * (zp - zm);
-                const double g2 = gx * gx + gy * gy + gz * gz + 1e-12;
-                double out = 0;
-                if (parts & LS_RHS_ADVECTION) {
-                    /* speed extended from the closest point of the zero level */
-                    double ox = -p0 * gx / g2, oy = -p0 * gy / g2, oz = -p0 * gz / g2;
-                    const double lim = FH - 1;
-                    ox = MAX(-lim, MIN(lim, ox));
-                    oy = MAX(-lim, MIN(lim, oy));
-                    oz = MAX(-lim, MIN(lim, oz));
-                    const double F0 = fpad[FPI(i, j, k)];
-                    const double fx = floor(ox), fy = floor(oy), fz = floor(oz);
-                    const double tx = ox - fx, ty = oy - fy, tz = oz - fz;
-                    const float *f = &fpad[FPI(i + (int)fx, j + (int)fy, k + (int)fz)];
-                    const double fv[8] = {f[0], f[1], f[FP], f[FP + 1], f[FP * FP],
-                                          f[FP * FP + 1], f[FP * FP + FP], f[FP * FP + FP + 1]};
-                    const double w[8] = {(1 - tx) * (1 - ty) * (1 - tz), tx * (1 - ty) * (1 - tz),
-                                         (1 - tx) * ty * (1 - tz),       tx * ty * (1 - tz),
-                                         (1 - tx) * (1 - ty) * tz,       tx * (1 - ty) * tz,
-                                         (1 - tx) * ty * tz,             tx * ty * tz};
-                    double Fe = 0;
-                    for (int q = 0; q < 8; q++)
-                        Fe += w[q] * (isnan(fv[q]) ? F0 : fv[q]);
-                    const double vel = alpha * Fe;
-                    if (fabs(Fe) > fbig)
-                        fbig = fabs(Fe);
-                    const double dmx = p0 - xm, dpx = xp - p0, dmy = p0 - ym, dpy = yp - p0,
-                                 dmz = p0 - zm, dpz = zp - p0;
-                    double up2;
-                    if (vel > 0) /* front moves outward: information from inside */
-                        up2 = sq(MIN(dmx, 0)) + sq(MAX(dpx, 0)) + sq(MIN(dmy, 0)) +
-                              sq(MAX(dpy, 0)) + sq(MIN(dmz, 0)) + sq(MAX(dpz, 0));
-                    else
-                        up2 = sq(MAX(dmx, 0)) + sq(MIN(dpx, 0)) + sq(MAX(dmy, 0)) +
-                              sq(MIN(dpy, 0)) + sq(MAX(dmz, 0)) + sq(MIN(dpz, 0));
-                    out += vel * sqrt(up2);
-                }
-                if (parts & LS_RHS_CURVATURE) {
-                    const double pxx = xp - 2 * p0 + xm, pyy = yp - 2 * p0 + ym,
-                                 pzz = zp - 2 * p0 + zm;
-                    const double pxy = 0.25 * (V(1, 1, 0) - V(1, -1, 0) - V(-1, 1, 0) + V(-1, -1, 0));
-                    const double pxz = 0.25 * (V(1, 0, 1) - V(1, 0, -1) - V(-1, 0, 1) + V(-1, 0, -1));
-                    const double pyz = 0.25 * (V(0, 1, 1) - V(0, 1, -1) - V(0, -1, 1) + V(0, -1, -1));
-                    const double num = pxx * (gy * gy + gz * gz) + pyy * (gx * gx + gz * gz) +
-                                       pzz * (gx * gx + gy * gy) -
-                                       2 * (gx * gy * pxy + gx * gz * pxz + gy * gz * pyz);
-                    const double gn = sqrt(g2);
-                    double H = 0.5 * num / (g2 * gn); /* mean curvature, 1/cells */
-                    H = H / sqrt(1.0 + H * H); /* smooth clamp to a radius of a cell */
-                    out += beta * H * gn;
-                }
-#undef V
-                ydot[a] = out;
-            }
+#pragma omp parallel for schedule(dynamic, 4) reduction(max : fbig)
+    for (size_t b = 0; b < nb; b++) {
+        const size_t a0 = r->bstart[b], a1 = r->bstart[b + 1];
+        if (a0 == a1)
+            continue;
+        const double *pad = r->pad + (size_t)r->padof[b] * P * P * P;
+        const float *fpad = r->Fpad + (size_t)r->padof[b] * FP * FP * FP;
+        for (size_t a = a0; a < a1; a++) {
+            const int l = (int)(band->act[a] % LS_B3);
+            const int i = l & 7, j = (l >> 3) & 7, k = l >> 6;
+            double fa = 0;
+            ydot[a] = r->edge[a] ? point_rhs(&pad[PI(i, j, k)], &fpad[FPI(i, j, k)], alpha, beta,
+                                             parts, true, fallback, &fa)
+                                 : point_rhs(&pad[PI(i, j, k)], &fpad[FPI(i, j, k)], alpha, beta,
+                                             parts, false, fallback, &fa);
+            if (fa > fbig)
+                fbig = fa;
         }
     }
     if (parts & LS_RHS_ADVECTION)
