@@ -19,7 +19,12 @@
  * is in layer floor(d / l0): layers [0, wallLayers) are MF_WALL (in the
  * pressure equation), the next dummyLayers MF_DUMMY (number density only).
  * A plane surface therefore gets one particle per layer on each lattice
- * line that crosses it, as a wall box does.
+ * line that crosses it, as a wall box does. A solid point with a lattice
+ * neighbour (26 in 3-D, 8 in 2-D) on the fluid side is MF_WALL whatever its
+ * depth: where two faces meet off the lattice the point at their edge can
+ * lie more than l0 from both, and a dummy particle there, with no pressure,
+ * is a hole the fluid leaks through. (On a plane tilted against the lattice
+ * this makes the wall layer up to sqrt(3) l0 thick.)
  *
  * Which side is solid (`side`):
  *   normals  the fluid is on the side the face normals point to (the

@@ -308,6 +308,7 @@ typedef struct mesh_item {
     char group[32], name[64];
     const mf_dict *dict;
     char where[512];      /* "file:line:col: wall 'name'" for messages */
+    char label[128];      /* "wall 'name'" */
     mf_trimesh mesh;
     mf_trimesh_report rep;
     double scale;
@@ -457,10 +458,10 @@ static int load_item(mf_scene_meshes *sm, const mf_trimesh_reader *reader, mesh_
     mf_loc_str(fe->loc, floc, sizeof floc);
     if (!reader || !reader->read)
         return MF_ERROR(MF_ERR_INPUT, "%s: %s: this program has no polygon file reader",
-                        floc, it->where);
+                        floc, it->label);
     int rc = reader->read(reader->ctx, s.file, fe->loc.file, &it->mesh);
     if (rc != 0)
-        return MF_ERROR(rc, "%s: %s: %s", floc, it->where, mf_error_message());
+        return MF_ERROR(rc, "%s: %s: %s", floc, it->label, mf_error_message());
     if (it->mesh.dropped)
         warn(sm, it, "%zu points or lines ignored (only triangles and polygons make surfaces)",
              it->mesh.dropped);
@@ -577,6 +578,7 @@ int mf_scene_meshes_create(const mf_dict *geometry, const mf_trimesh_reader *rea
             it->dict = e->items[0]->dict;
             mf_trimesh_init(&it->mesh);
             char loc[400];
+            snprintf(it->label, sizeof it->label, "%s '%s'", what_of(mesh_groups[g]), e->key);
             snprintf(it->where, sizeof it->where, "%s: %s '%s'",
                      mf_loc_str(e->loc, loc, sizeof loc), what_of(mesh_groups[g]), e->key);
             MF_CALL(load_item(sm, reader, it));
@@ -675,6 +677,64 @@ static int place_fixed(mf_scene_meshes *sm, mf_sim *sim, uint64_t key, int kind,
     return 0;
 }
 
+/* Which side of the surface is solid, and how deep a band point lies in
+ * it (mf_trimesh.h: side). */
+typedef struct side_rule {
+    int mode;
+    int out_sign; /* +1 when the normals of a closed surface point out */
+    double half;  /* side both: half the slab's thickness */
+} side_rule;
+
+static bool solid_depth(const side_rule *r, const band *b, size_t e, double *depth)
+{
+    const double dist = sqrt(b->d2[e]);
+    const int side = b->side[e];
+    switch (r->mode) {
+    case SIDE_NORMALS: /* fluid where the normals point: solid behind or on */
+        *depth = dist;
+        return side <= 0;
+    case SIDE_INSIDE: /* fluid inside: solid outside or on */
+        *depth = dist;
+        return r->out_sign * side >= 0;
+    case SIDE_OUTSIDE:
+        *depth = dist;
+        return r->out_sign * side <= 0;
+    default: /* both: the slab |d| < half */
+        *depth = r->half - dist;
+        return dist < r->half * (1 - LAYER_EPS);
+    }
+}
+
+/* A solid point with a fluid-side point among its lattice neighbours (26 in
+ * 3-D, 8 in 2-D) must be a wall particle whatever its distance: along the
+ * edges and at the corners of the fluid region the nearest solid points can
+ * lie more than l0 from the surface (a wall 0.97 l0 deep meets a floor
+ * 0.5 l0 deep at 1.08 l0), and a dummy particle there, which has no
+ * pressure, is where the fluid gets through. Outside the band lies deep
+ * solid, except around a slab (side both), whose band is the slab. */
+static bool touches_fluid(const side_rule *r, const band *b, uint64_t key, int dim)
+{
+    long idx[3];
+    lat_unkey(key, idx);
+    for (int dz = dim == 3 ? -1 : 0; dz <= (dim == 3 ? 1 : 0); dz++)
+        for (int dy = -1; dy <= 1; dy++)
+            for (int dx = -1; dx <= 1; dx++) {
+                if (!dx && !dy && !dz)
+                    continue;
+                long n[3] = {idx[0] + dx, idx[1] + dy, idx[2] + dz};
+                size_t slot = lmap_find(&b->map, lat_key(n));
+                if (slot == SIZE_MAX) {
+                    if (r->mode == SIDE_BOTH)
+                        return true;
+                    continue;
+                }
+                double depth;
+                if (!solid_depth(r, b, b->map.val[slot], &depth))
+                    return true;
+            }
+    return false;
+}
+
 static int cmp_u64(const void *a, const void *b)
 {
     uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
@@ -737,36 +797,20 @@ int mf_scene_mesh_wall(mf_scene_meshes *sm, mf_sim *sim, const char *name, const
         if (!keys)
             rc = MF_ERROR(MF_ERR_MEMORY, "out of memory");
     }
+    const side_rule rule = {mode, out_sign, half};
     for (size_t e = 0; rc == 0 && e < b.n; e++) {
-        double dist = sqrt(b.d2[e]);
-        int side = b.side[e];
         double depth;
-        switch (mode) {
-        case SIDE_NORMALS: /* fluid where the normals point: solid behind or on */
-            if (side > 0) continue;
-            depth = dist;
-            break;
-        case SIDE_INSIDE: /* fluid inside: solid outside or on */
-            if (out_sign * side < 0) continue;
-            depth = dist;
-            break;
-        case SIDE_OUTSIDE:
-            if (out_sign * side > 0) continue;
-            depth = dist;
-            break;
-        default: /* both: the slab |d| < half */
-            if (dist >= half * (1 - LAYER_EPS)) continue;
-            depth = half - dist;
-            break;
-        }
+        if (!solid_depth(&rule, &b, e, &depth))
+            continue;
         long layer = (long)floor(depth / l0 + LAYER_EPS);
         if (layer >= nlayers) {
             if (mode != SIDE_BOTH)
                 continue;
             layer = nlayers - 1; /* the middle of a thick slab */
         }
+        bool wall = layer < s.wall_layers || touches_fluid(&rule, &b, b.key[e], sm->L.dim);
         /* The kind goes in the key's spare top bit until placement. */
-        keys[nkeys++] = b.key[e] | (layer < s.wall_layers ? 1ULL << 63 : 0);
+        keys[nkeys++] = b.key[e] | (wall ? 1ULL << 63 : 0);
     }
     if (rc == 0) {
         qsort(keys, nkeys, sizeof *keys, cmp_u64);

@@ -10,8 +10,12 @@
  *   point-only files give errors naming the file;
  * - walls: a closed box mesh with `side inside` makes exactly the wall layer
  *   of the equivalent wall box (3-D, and 2-D from a box extruded across
- *   z = 0); every wall particle of a tilted plane lies within [0, l0) of it
- *   and behind it, dummies within [l0, 3 l0); about 1/l0^2 per layer;
+ *   z = 0); every point of a tilted plane within l0 behind it is a wall
+ *   particle, and every wall particle lies within sqrt(3) l0 of it
+ *   and behind it, dummies within [l0, 3 l0); about 1/l0^2 per layer; a
+ *   tank whose faces are off the lattice has no dummy particle next to the
+ *   fluid (the lattice points at its edges are walls though more than l0
+ *   deep);
  * - a sphere filled with fluid: the count is its volume / l0^3 within 2%,
  *   every particle inside; the same sphere as a wall around the fluid leaves
  *   no two particles closer than l0/2;
@@ -475,6 +479,61 @@ static void test_box_equivalence(int dim)
     scene_free(&b);
 }
 
+/* Faces off the lattice: a wall 0.97 l0 deep meets a floor 0.5 l0 deep,
+ * and the lattice point at the edge between them lies 1.08 l0 from the
+ * surface. It must still be a wall particle: no dummy particle may have a
+ * lattice neighbour (26 of them) inside the tank. */
+static void test_closed_shell(void)
+{
+    const double l0 = 0.025;
+    const double mn[3] = {0, 0, 0.0123}, mx[3] = {0.9993, 0.6, 0.4123};
+    mf_trimesh box;
+    mf_trimesh_init(&box);
+    mesh_box(&box, mn, mx);
+    char path[512];
+    tmp_path(path, sizeof path, "offset_tank.obj");
+    CHECK(write_obj(path, &box, 1) == 0);
+    mf_trimesh_free(&box);
+    scene sc;
+    CHECK_MSG(scene_build(&sc, "dimension 3; particleSpacing 0.025;"
+                               "walls { tank { type mesh; file \"offset_tank.obj\"; side inside; } }")
+                  == 0, "%s", sc.error);
+    if (sc.rc == 0) {
+        const mf_particles *p = sc.sim.p;
+        size_t open = 0, deep = 0;
+        for (size_t i = 0; i < p->n; i++) {
+            if (p->kind[i] != MF_DUMMY)
+                continue;
+            for (int k = 0; k < 27; k++) {
+                double y[3] = {p->pos[3 * i] + (k % 3 - 1) * l0,
+                               p->pos[3 * i + 1] + (k / 3 % 3 - 1) * l0,
+                               p->pos[3 * i + 2] + (k / 9 - 1) * l0};
+                bool in = true;
+                for (int a = 0; a < 3; a++)
+                    in = in && y[a] > mn[a] && y[a] < mx[a];
+                open += in;
+            }
+        }
+        /* And every wall particle is within sqrt(3) l0 of the tank. */
+        for (size_t i = 0; i < p->n; i++) {
+            if (p->kind[i] != MF_WALL)
+                continue;
+            double d2 = 0;
+            for (int a = 0; a < 3; a++) {
+                double x = p->pos[3 * i + a], out = x < mn[a] ? mn[a] - x : (x > mx[a] ? x - mx[a] : 0);
+                d2 += out * out;
+            }
+            deep += d2 > 3 * l0 * l0;
+        }
+        printf("offset tank: %zu wall, %zu dummy; %zu dummy-fluid contacts, %zu walls too deep\n",
+               count_kind(p, MF_WALL), count_kind(p, MF_DUMMY), open, deep);
+        CHECK(open == 0);
+        CHECK(deep == 0);
+        CHECK_OK(mf_scene_check_overlap(&sc.sim));
+    }
+    scene_free(&sc);
+}
+
 /* A large tilted square (open): layers behind it, by distance. */
 static void test_tilted_plane(void)
 {
@@ -518,9 +577,12 @@ static void test_tilted_plane(void)
                 along_v += d[k] * v[k];
             }
             bool inner = fabs(along_u) < 0.5 && fabs(along_v) < 0.5; /* not near the rim */
+            /* Layer 0 (within l0 behind the plane) is wall; deeper points are
+             * dummy unless a lattice neighbour is on the fluid side (within
+             * sqrt(3) l0 of the plane). */
             if (p->kind[i] == MF_WALL) {
                 nwall++;
-                if (inner && !(sd <= 1e-12 && sd > -l0))
+                if (inner && !(sd <= 1e-12 && sd > -sqrt(3.0) * l0))
                     bad++;
             } else {
                 ndummy++;
@@ -680,9 +742,10 @@ static void test_plate(void)
             }
             if (fabs(sd) >= 0.04)
                 wrong++;
-            /* Away from the rim, wall particles are the outer l0 of the slab. */
+            /* Away from the rim, the outer l0 of the slab is wall, and so is
+             * what touches the fluid (within sqrt(3) l0 of the slab's face). */
             bool inner = fabs(p->pos[3 * i] - o[0]) < 0.3 && fabs(along) < 0.3;
-            if (inner && p->kind[i] == MF_WALL && !(fabs(sd) > 0.04 - l0 - 1e-12))
+            if (inner && p->kind[i] == MF_WALL && !(fabs(sd) > 0.04 - sqrt(3.0) * l0 - 1e-12))
                 wrong++;
             if (inner && p->kind[i] == MF_DUMMY && !(fabs(sd) <= 0.04 - l0 + 1e-12))
                 wrong++;
@@ -904,6 +967,7 @@ int main(void)
     test_files();
     test_box_equivalence(3);
     test_box_equivalence(2);
+    test_closed_shell();
     test_tilted_plane();
     test_sphere_fill();
     test_plate();

@@ -34,6 +34,7 @@ typedef struct mps_settings {
     bool gradient_pmin;       /* eq. 5 with p_min (Koshizuka et al. 1998) */
     bool collision;           /* optional collision model (off: the paper uses none) */
     double collision_distance; /* in l0 */
+    bool collision_after_correction; /* a second collision pass after eqs. 15-17 */
     double restitution;
     long reorder_interval;    /* sort particles along cells every N steps (0: never) */
 } mps_settings;
@@ -101,7 +102,7 @@ typedef struct mps_data {
 enum { MPS_FLAG_SURFACE = 1 }; /* bits of the Flags field */
 
 extern const mf_solver_ops mf_solver_MPS;
-#define MPS_NPARAMS 12 /* checked against the table in mps_params.c */
+#define MPS_NPARAMS 13 /* checked against the table in mps_params.c */
 extern const mf_param mps_params[MPS_NPARAMS];
 /* The entries of that table, for a solver whose settings embed an
  * mps_settings (the multi-fluid solver): OFF(field) is the offset of the
@@ -131,6 +132,9 @@ extern const mf_param mps_params[MPS_NPARAMS];
      "pressure gradient with p_min of the neighbourhood (eq. 5 note)"},                         \
     {"collision", MF_PARAM_BOOL, "no", MF_NO_RANGE, NULL, OFF(collision),                       \
      "push apart particles closer than collisionDistance (not in the paper)"},                  \
+    {"collisionAfterCorrection", MF_PARAM_BOOL, "no", MF_NO_RANGE, NULL,                        \
+     OFF(collision_after_correction),                                                           \
+     "collide again after the pressure correction (keeps fluid out of thin walls)"},            \
     {"collisionDistance", MF_PARAM_SCALAR, "0.5", 0.1, 1, NULL,                                 \
      OFF(collision_distance), "collision distance, in l0"},                                     \
     {"restitution", MF_PARAM_SCALAR, "0.2", 0, 1, NULL, OFF(restitution),                       \

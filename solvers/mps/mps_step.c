@@ -206,6 +206,8 @@ int mps_correction_phase(mps_data *d, mf_sim *sim, double dt)
             p->pos[3 * i + c] += dt * du;
         }
     }
+    if (d->s.collision && d->s.collision_after_correction)
+        collide(d, sim, dt);
     d->t_correction += mf_wall_seconds() - t0;
     return 0;
 }
