@@ -6,7 +6,8 @@
  *                      follows the roundness of the drop (a square relaxes
  *                      to a circle of radius s / sqrt(pi)).
  *   oscillationPeriod  a drop oscillating in mode 2: the period of the
- *                      quadrupole moment Q = <(x-xc)^2 - (y-yc)^2> against
+ *                      quadrupole moment Q = <(x-xc)^2 - (y-yc)^2> (from its
+ *                      zero crossings; the x and y extents too) against
  *                      Rayleigh's, omega^2 = 6 sigma/(rho R^3) (2-D) or
  *                      8 sigma/(rho R^3) (3-D).
  *   layering           two fluids settling: error = the fraction of light
@@ -165,7 +166,7 @@ static int write_report(const char *case_dir, const char *comment, const char *h
 
 typedef struct laplace_settings {
     const char *metric, *drop;
-    double sigma, radius, side, settle, margin;
+    double sigma, radius, side, settle, margin, inner;
 } laplace_settings;
 
 static const mf_param laplace_params[] = {
@@ -178,11 +179,14 @@ static const mf_param laplace_params[] = {
     {"radius", MF_PARAM_SCALAR, "0", 0, 1e6, NULL, offsetof(laplace_settings, radius),
      "R of the drop, m (or give squareSide)"},
     {"squareSide", MF_PARAM_SCALAR, "0", 0, 1e6, NULL, offsetof(laplace_settings, side),
-     "side s of a square (2-D) drop: R = s / sqrt(pi)"},
+     "side s of a square (2-D) drop: R = s / sqrt(pi), s^2 the area its particles fill "
+     "(N l0^2 at the first snapshot: s itself when l0 divides it)"},
     {"settleTime", MF_PARAM_SCALAR, "0", 0, 1e9, NULL, offsetof(laplace_settings, settle),
      "average dp over the snapshots after this time, s"},
     {"margin", MF_PARAM_SCALAR, "5", 0, 100, NULL, offsetof(laplace_settings, margin),
-     "p_in over r < R - margin l0, p_out over R + margin l0 < r < R + 2 margin l0"},
+     "p_out over R + margin l0 < r < R + 2 margin l0 (another fluid around the drop)"},
+    {"innerRadius", MF_PARAM_SCALAR, "0.5", 0.01, 1, NULL, offsetof(laplace_settings, inner),
+     "p_in over r < innerRadius R (the drop's core, away from the interface band)"},
 };
 static const char *const metric_extra[] = {"FoamFile", NULL};
 
@@ -215,7 +219,7 @@ static double roundness(const snap *s, int fluid, const double c[3], double R)
 static int laplace_evaluate(const char *case_dir, const mf_dict *md, double *error)
 {
     laplace_settings s;
-    MF_CALL(mf_params_apply(laplace_params, 7, md, metric_extra, &s, NULL));
+    MF_CALL(mf_params_apply(laplace_params, 8, md, metric_extra, &s, NULL));
     double R = s.radius > 0 ? s.radius : s.side / sqrt(M_PI);
     if (!(R > 0))
         return MF_ERROR(MF_ERR_INPUT, "%s/validation/metric: give radius or squareSide",
@@ -243,6 +247,8 @@ static int laplace_evaluate(const char *case_dir, const mf_dict *md, double *err
         double c[3];
         size_t count = 0;
         centroid(&sn, drop, c, &count);
+        if (k == 0 && !(s.radius > 0) && dim == 2 && count > 0)
+            R = sqrt((double)count * l0 * l0 / M_PI); /* the square the lattice filled */
         double pin = 0, pout = 0;
         size_t nin = 0, nout = 0;
         const double m = s.margin * l0;
@@ -253,7 +259,7 @@ static int laplace_evaluate(const char *case_dir, const mf_dict *md, double *err
             for (int a = 0; a < dim; a++)
                 r += (p->pos[3 * i + a] - c[a]) * (p->pos[3 * i + a] - c[a]);
             r = sqrt(r);
-            if (is_of(&sn, i, drop) && r < R - m) {
+            if (is_of(&sn, i, drop) && r < s.inner * R) {
                 pin += sn.p[i];
                 nin++;
             } else if (!is_of(&sn, i, drop) && r > R + m && r < R + 2 * m) {
@@ -295,20 +301,20 @@ static int laplace_evaluate(const char *case_dir, const mf_dict *md, double *err
     const double laplace = (dim == 3 ? 2 : 1) * s.sigma / R;
     if (rc == 0 && used == 0)
         rc = MF_ERROR(MF_ERR_INPUT, "%s: no snapshot after settleTime %g with particles inside "
-                      "R - margin l0", case_dir, s.settle);
+                      "innerRadius R", case_dir, s.settle);
     if (rc == 0) {
         double dp = sum / (double)used, dpf = sum_force / (double)used;
         *error = fabs(dp - laplace) / laplace;
         char comment[1024], title[256];
         snprintf(comment, sizeof comment,
                  "Laplace pressure of a drop: dp = p_in - p_out against %s sigma / R = %.6g Pa "
-                 "(sigma = %g N/m, R = %g m)\np_in: mean over the drop within R - %g l0 of its "
+                 "(sigma = %g N/m, R = %g m)\np_in: mean over the drop within %g R of its "
                  "centroid; p_out: other fluid between R + %g l0 and R + %g l0 (0 if none)\n"
                  "mean dp over %zu snapshots after t = %g s: %.6g Pa; relative error %.6g\n"
                  "roundness: std/mean of the outer radius in 36 sectors (square ~0.12)\n"
                  "dp_force: the surface-tension force per unit volume integrated across the "
                  "interface; mean %.6g Pa, relative error %.6g",
-                 dim == 3 ? "2" : "", laplace, s.sigma, R, s.margin, s.margin, 2 * s.margin,
+                 dim == 3 ? "2" : "", laplace, s.sigma, R, s.inner, s.margin, 2 * s.margin,
                  used, s.settle, dp, *error, dpf, fabs(dpf - laplace) / laplace);
         snprintf(title, sizeof title, "Droplet pressure jump (error %.3g)", *error);
         double tx[2] = {t.col[0][0], t.col[0][t.n - 1]}, ty[2] = {laplace, laplace};
@@ -350,19 +356,26 @@ static const mf_param osc_params[] = {
      "ignore the snapshots before this time, s"},
 };
 
-/* Times where q(t) - mean crosses zero upward, linearly interpolated. */
-static size_t upward_crossings(const double *t, const double *q, size_t n, double *out)
+/* Times where q(t) crosses zero, either way, linearly interpolated. Zero is
+ * the circle (sphere) at rest; the mean of q over the run is not, when the
+ * amplitude decays. Successive crossings are half a period apart. */
+static size_t zero_crossings(const double *t, const double *q, size_t n, double *out)
 {
-    double mean = 0;
-    for (size_t i = 0; i < n; i++)
-        mean += q[i] / (double)n;
     size_t m = 0;
     for (size_t i = 1; i < n; i++) {
-        double a = q[i - 1] - mean, b = q[i] - mean;
-        if (a < 0 && b >= 0)
+        double a = q[i - 1], b = q[i];
+        if ((a < 0 && b >= 0) || (a > 0 && b <= 0))
             out[m++] = t[i - 1] + (t[i] - t[i - 1]) * (-a) / (b - a);
     }
     return m;
+}
+
+/* The period from the zero crossings of q: 2 (t_last - t_first)/(n - 1). */
+static double crossing_period(const double *t, const double *q, size_t n, double *cross,
+                              size_t *nc)
+{
+    *nc = zero_crossings(t, q, n, cross);
+    return *nc >= 2 ? 2 * (cross[*nc - 1] - cross[0]) / (double)(*nc - 1) : NAN;
 }
 
 static int osc_evaluate(const char *case_dir, const mf_dict *md, double *error)
@@ -375,7 +388,7 @@ static int osc_evaluate(const char *case_dir, const mf_dict *md, double *error)
     int *idx = NULL;
     size_t nsnap = 0;
     MF_CALL(mf_list_snapshots(case_dir, &idx, &nsnap));
-    table t = {.ncols = 2};
+    table t = {.ncols = 4};
     int rc = 0, dim = 2;
     for (size_t k = 0; rc == 0 && k < nsnap; k++) {
         snap sn;
@@ -400,13 +413,18 @@ static int osc_evaluate(const char *case_dir, const mf_dict *md, double *error)
             }
         for (int a = 0; nb && a < 2; a++)
             c2[a] /= (double)nb;
+        double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
         for (size_t i = 0; i < p->n; i++)
             if (is_of(&sn, i, drop) &&
                 hypot(p->pos[3 * i] - c[0], p->pos[3 * i + 1] - c[1]) < 2 * s.radius) {
                 double dx = p->pos[3 * i] - c2[0], dy = p->pos[3 * i + 1] - c2[1];
                 q += (dx * dx - dy * dy) / (double)nb;
+                for (int a = 0; a < 2; a++) {
+                    lo[a] = fmin(lo[a], p->pos[3 * i + a]);
+                    hi[a] = fmax(hi[a], p->pos[3 * i + a]);
+                }
             }
-        double row[2] = {sn.h.time, q};
+        double row[4] = {sn.h.time, q, hi[0] - lo[0], hi[1] - lo[1]};
         if (sn.h.time >= s.start)
             rc = table_add(&t, row);
         snap_free(&sn);
@@ -415,26 +433,35 @@ static int osc_evaluate(const char *case_dir, const mf_dict *md, double *error)
     const double omega = sqrt((dim == 3 ? 8.0 : 6.0) * s.sigma / (s.rho * pow(s.radius, 3)));
     const double period_ref = 2 * M_PI / omega;
     double *cross = t.n ? malloc(t.n * sizeof *cross) : NULL;
-    size_t nc = cross ? upward_crossings(t.col[0], t.col[1], t.n, cross) : 0;
-    if (rc == 0 && nc < 2)
-        rc = MF_ERROR(MF_ERR_INPUT, "%s: the quadrupole moment crosses its mean upward %zu "
-                      "time(s): run longer than two periods (Rayleigh: %.4g s)",
+    double *dext = t.n ? malloc(t.n * sizeof *dext) : NULL;
+    size_t nc = 0, ne = 0;
+    double period = NAN, period_ext = NAN;
+    if (cross && dext) {
+        for (size_t k = 0; k < t.n; k++)
+            dext[k] = t.col[2][k] - t.col[3][k];
+        period_ext = crossing_period(t.col[0], dext, t.n, cross, &ne);
+        period = crossing_period(t.col[0], t.col[1], t.n, cross, &nc);
+    }
+    if (rc == 0 && nc < 4)
+        rc = MF_ERROR(MF_ERR_INPUT, "%s: the quadrupole moment crosses zero %zu time(s): run "
+                      "longer than two periods (Rayleigh: %.4g s)",
                       case_dir, nc, period_ref);
     if (rc == 0) {
-        double period = (cross[nc - 1] - cross[0]) / (double)(nc - 1);
         *error = fabs(period - period_ref) / period_ref;
-        char comment[768], title[256];
+        char comment[1024], title[256];
         snprintf(comment, sizeof comment,
-                 "mode-2 oscillation of a drop: Q = <(x-xc)^2 - (y-yc)^2> over the drop\n"
-                 "period from %zu upward mean crossings: %.6g s; Rayleigh (%d-D, omega^2 = %d "
-                 "sigma/(rho R^3), sigma = %g, rho = %g, R = %g): %.6g s; relative error %.6g",
-                 nc, period, dim, dim == 3 ? 8 : 6, s.sigma, s.rho, s.radius, period_ref,
-                 *error);
+                 "mode-2 oscillation of a drop: Q = <(x-xc)^2 - (y-yc)^2> over the drop; its "
+                 "x and y extents\nperiod from %zu zero crossings of Q: %.6g s (from %zu of "
+                 "x_extent - y_extent: %.6g s); Rayleigh (%d-D, omega^2 = %d sigma/(rho R^3), "
+                 "sigma = %g, rho = %g, R = %g): %.6g s; relative error %.6g",
+                 nc, period, ne, period_ext, dim, dim == 3 ? 8 : 6, s.sigma, s.rho, s.radius,
+                 period_ref, *error);
         snprintf(title, sizeof title, "Droplet oscillation (period error %.3g)", *error);
         mf_plot plot = {title, "t, s", "Q, m^2", false, false, NULL};
         mf_series series[1] = {{"mpsflow", t.col[0], t.col[1], t.n, "linespoints", NULL}};
-        rc = write_report(case_dir, comment, "t,Q", &t, &plot, series, 1);
+        rc = write_report(case_dir, comment, "t,Q,x_extent,y_extent", &t, &plot, series, 1);
     }
+    free(dext);
     free(cross);
     table_free(&t);
     return rc;

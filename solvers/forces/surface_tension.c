@@ -48,6 +48,18 @@
  * equal shares) and a free surface, which has one side, 2 sigma_x kappa g^0.
  * The force per unit volume integrated across the interface is sigma kappa.
  *
+ * Free surfaces, freeSurface:
+ *   force:    (default) the paper's form above. The free-surface particles of
+ *             the solver (eq. 18: n* < beta n0, p = 0) are the outer layers of
+ *             the band: they take their share of the force with no pressure,
+ *             and the pressure inside a drop comes out about 0.6-0.7 sigma/R.
+ *   pressure: the Laplace pressure sigma kappa is the Dirichlet value of the
+ *             solver's free-surface particles instead of 0 (the usual
+ *             free-surface treatment of surface tension), and no force acts on
+ *             free surfaces (it would count the jump twice); the curvature is
+ *             computed as above. A solver applies it through
+ *             mf_forces_surface_pressure (forces.h): multiFluid, one solve.
+ *
  * Tension of a pair: sigma_xy of an `interfaces` entry, else Antonow's rule
  * |sigma_x - sigma_y| (a fluid against one with sigma 0 keeps its own
  * sigma); a free surface of fluid x: sigma_x.
@@ -68,10 +80,12 @@ typedef struct st_settings {
     double beta;            /* free surface below beta N_full */
     double dt_factor;       /* capillary time step factor */
     long smoothing;         /* passes of curvature smoothing */
+    const char *free_surface; /* force | pressure */
     const mf_dict *interfaces;
 } st_settings;
 
 static const char *const curvature_models[] = {"exact", "paper", "normal", NULL};
+static const char *const free_surface_models[] = {"force", "pressure", NULL};
 
 static const mf_param st_params[] = {
     {"radius", MF_PARAM_SCALAR, "4.1", 1.5, 10, NULL, offsetof(st_settings, radius),
@@ -87,6 +101,12 @@ static const mf_param st_params[] = {
      "mean density"},
     {"smoothing", MF_PARAM_INT, "1", 0, 10, NULL, offsetof(st_settings, smoothing),
      "passes of curvature averaging over the free-surface particles within r_st (0: none)"},
+    {"freeSurface", MF_PARAM_WORD, "force", MF_NO_RANGE, free_surface_models,
+     offsetof(st_settings, free_surface),
+     "a free surface of a fluid with sigma > 0: force (eq. 33 on its interface band; its "
+     "free-surface particles keep p = 0, eq. 18) or pressure (they hold the Laplace "
+     "pressure sigma kappa instead, and no force acts there; needs solver multiFluid with "
+     "one pressure solve per step)"},
     {"interfaces", MF_PARAM_DICT, NULL, MF_NO_RANGE, NULL, offsetof(st_settings, interfaces),
      "tension of fluid pairs: name { fluids (a b); sigma 0.03; } (else |sigma_a - sigma_b|)"},
 };
@@ -97,6 +117,8 @@ static const mf_param st_params[] = {
 typedef struct st_data {
     st_settings s;
     bool paper, normal;
+    bool pressure_mode;        /* freeSurface pressure: p = sigma kappa, no force there */
+    bool claimed;              /* a solver applies the surface pressure */
     double g_ref;              /* |delta n| of the outer layer of a flat lattice surface */
     int dim;
     double l0, r;              /* r = r_st in m */
@@ -114,6 +136,8 @@ typedef struct st_data {
     int32_t *n1, *nall;
     double *kappa, *kappa_s, *fdir;
     double *nrm;               /* outward unit normal of the particle's own fluid; 0: none */
+    double *p_surface;         /* freeSurface pressure: sigma kappa near a free surface; NAN */
+    size_t p_surface_n;        /* particles p_surface holds (this step's) */
 } st_data;
 
 /* ---- curvature from the filled fraction f of the r_st disk (ball) --------- */
@@ -292,6 +316,7 @@ static void st_destroy(void *data)
     free(d->kappa_s);
     free(d->fdir);
     free(d->nrm);
+    free(d->p_surface);
     free(d);
 }
 
@@ -300,6 +325,7 @@ static int st_create_data(const st_settings *s, mf_sim *sim, st_data *d)
     d->s = *s;
     d->paper = strcmp(s->curvature, "paper") == 0;
     d->normal = strcmp(s->curvature, "normal") == 0;
+    d->pressure_mode = strcmp(s->free_surface, "pressure") == 0;
     d->dim = sim->dim;
     d->l0 = sim->l0;
     d->r = s->radius * sim->l0;
@@ -315,8 +341,10 @@ static int st_create_data(const st_settings *s, mf_sim *sim, st_data *d)
                                        &d->f_accel));
     mf_log_printf(sim->log, MF_LOG_NORMAL,
                   "surfaceTension: r_st = %g l0, N_full = %g, n0^st = %g (flat interface), "
-                  "curvature %s\n",
-                  s->radius, d->n_full, d->n0st, s->curvature);
+                  "curvature %s, free surfaces by %s\n",
+                  s->radius, d->n_full, d->n0st, s->curvature,
+                  d->pressure_mode ? "pressure (p = sigma kappa, eq. 18; no force there)"
+                                   : "force (eq. 33)");
     for (int x = 0; x < sim->nfluids; x++)
         for (int y = x; y < sim->nfluids; y++)
             if (d->sigma[x][y] > 0) {
@@ -403,7 +431,10 @@ static int reserve(st_data *d, size_t n)
     double *nr = realloc(d->nrm, 3 * cap * sizeof *nr);
     if (nr)
         d->nrm = nr;
-    if (!n1 || !nall || !k || !ks || !f || !nr)
+    double *ps = realloc(d->p_surface, cap * sizeof *ps);
+    if (ps)
+        d->p_surface = ps;
+    if (!n1 || !nall || !k || !ks || !f || !nr || !ps)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu particles", n);
     d->cap = cap;
     return 0;
@@ -603,6 +634,49 @@ static void normal_divergence(st_data *d, const mf_particles *p, const int32_t *
     }
 }
 
+/* freeSurface pressure: the Laplace pressure sigma_x kappa of every fluid
+ * particle near a free surface of a fluid with sigma_x > 0, for the solver
+ * to hold on its free-surface (Dirichlet) particles of eq. 18 at r*. A
+ * free-surface interface particle takes its own (smoothed) curvature; any
+ * other particle the mean of those within r_st (weight 1 - r/r_st): the
+ * solver's free surface (n* < beta n0 at r*) is not exactly the one found
+ * here (a count within r_st at r^n). NAN where there is none. */
+static void surface_pressure(st_data *d, const mf_particles *p, const int32_t *fid,
+                             const mf_nlist *nl, const double *kap)
+{
+    const double rst = d->r;
+    const long np = (long)p->n_owned;
+#pragma omp parallel for schedule(dynamic, 64)
+    for (long i = 0; i < np; i++) {
+        d->p_surface[i] = NAN;
+        if (p->kind[i] != MF_FLUID)
+            continue;
+        const int x = fluid_of(fid, (size_t)i);
+        const double sig = d->sigma[x][x];
+        if (!(sig > 0))
+            continue;
+        if (d->fdir[3 * i] != 0 && !isnan(kap[i])) {
+            d->p_surface[i] = sig * kap[i];
+            continue;
+        }
+        double sw = 0, sk = 0, r[3];
+        for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
+            size_t j = nl->j[k];
+            if (p->kind[j] != MF_FLUID || d->fdir[3 * j] == 0 || isnan(kap[j]) ||
+                fluid_of(fid, j) != x)
+                continue;
+            double len = dist(&p->pos[3 * i], &p->pos[3 * j], r);
+            if (len >= rst)
+                continue;
+            sw += 1 - len / rst;
+            sk += (1 - len / rst) * kap[j];
+        }
+        if (sw > 0)
+            d->p_surface[i] = sig * sk / sw;
+    }
+    d->p_surface_n = (size_t)np;
+}
+
 static int st_accumulate(void *data, const mf_sim *sim, double *acc)
 {
     st_data *d = data;
@@ -611,8 +685,15 @@ static int st_accumulate(void *data, const mf_sim *sim, double *acc)
     double *accel_out = mf_particles_fd(p, d->f_accel);
     memset(kappa_out, 0, p->n * sizeof *kappa_out);
     memset(accel_out, 0, 3 * p->n * sizeof *accel_out);
+    d->p_surface_n = 0;
     if (!d->any)
         return 0;
+    if (d->pressure_mode && !d->claimed)
+        return MF_ERROR(MF_ERR_INPUT, "system/solverDict: forces { surfaceTension { "
+                        "freeSurface pressure; } } makes the Laplace pressure the free "
+                        "surface's Dirichlet value, which this solver does not apply (use "
+                        "solver multiFluid with one pressure solve per step, or freeSurface "
+                        "force)");
     const mf_nlist *nl = NULL;
     MF_CALL(neighbours(d, sim, &nl));
     MF_CALL(reserve(d, p->n));
@@ -726,7 +807,7 @@ static int st_accumulate(void *data, const mf_sim *sim, double *acc)
             if (len >= rst || len <= 0)
                 continue;
             double s = colour_weight(len, rst) / len; /* phi(r) r_hat */
-            double coef = free_surface ? 2 * d->sigma[x][x] * kap[i] : 0.0;
+            double coef = free_surface && !d->pressure_mode ? 2 * d->sigma[x][x] * kap[i] : 0.0;
             if (!own(p, fid, j, x)) {
                 double kj = isnan(kap[j]) ? -kap[i] : kap[j];
                 coef -= d->sigma[x][fluid_of(fid, j)] * 0.5 * (kap[i] - kj);
@@ -741,6 +822,8 @@ static int st_accumulate(void *data, const mf_sim *sim, double *acc)
         }
         kappa_out[i] = kap[i];
     }
+    if (d->pressure_mode)
+        surface_pressure(d, p, fid, nl, kap);
     return 0;
 }
 
@@ -772,6 +855,37 @@ double mf_forces_stable_dt(const mf_sim *sim)
                 dt = lim;
         }
     return dt;
+}
+
+bool mf_forces_claim_surface_pressure(mf_sim *sim)
+{
+    bool any = false;
+    for (size_t k = 0; k < sim->nforces; k++)
+        if (sim->forces[k].info == &mf_force_surfaceTension.info && sim->forces[k].data) {
+            st_data *d = sim->forces[k].data;
+            if (d->pressure_mode && d->any) {
+                d->claimed = true;
+                any = true;
+            }
+        }
+    return any;
+}
+
+void mf_forces_surface_pressure(const mf_sim *sim, const uint8_t *dirichlet, double *p)
+{
+    const mf_particles *ps = sim->p;
+    for (size_t i = 0; i < ps->n; i++)
+        p[i] = 0;
+    for (size_t k = 0; k < sim->nforces; k++) {
+        if (sim->forces[k].info != &mf_force_surfaceTension.info || !sim->forces[k].data)
+            continue;
+        const st_data *d = sim->forces[k].data;
+        if (!d->pressure_mode)
+            continue;
+        for (size_t i = 0; i < d->p_surface_n && i < ps->n_owned; i++)
+            if (dirichlet[i] && ps->kind[i] == MF_FLUID && !isnan(d->p_surface[i]))
+                p[i] += d->p_surface[i];
+    }
 }
 
 const mf_force_ops mf_force_surfaceTension = {

@@ -19,8 +19,13 @@
  *                      correct both, and repeat at the corrected positions
  *                      until they move by less than outerTolerance l0.
  *
+ * With surfaceTension's `freeSurface pressure` (one solve per step) the
+ * free-surface particles hold the Laplace pressure sigma kappa instead of 0
+ * (multifluid_surface.c).
+ *
  * With one fluid there is no FluidId field and a step is mps_lagrangian_step
- * itself: the MPS result, bit for bit.
+ * itself: the MPS result, bit for bit (with freeSurface pressure, its phases
+ * with the surface pressure and correction of multifluid_surface.c).
  */
 #ifndef MULTIFLUID_H
 #define MULTIFLUID_H
@@ -46,6 +51,7 @@ typedef struct multifluid_data {
     int f_fluid;               /* FluidId, or -1 with one fluid */
     int f_light_pressure;      /* LightPressure (iterative mode), or -1 */
     bool iterative;
+    bool surface_pressure;     /* surfaceTension freeSurface pressure: p = sigma kappa, eq. 18 */
     double ratio;              /* largest / smallest density */
     double rho_min, rho_max;
     bool heavy[MF_MAX_FLUIDS]; /* fluids solved in the heavy step (rho >= threshold rho_min) */
@@ -72,5 +78,11 @@ int multifluid_step(multifluid_data *d, mf_sim *sim, double dt);
 
 /* multifluid_pressure.c: the iterative two-step pressure (section 3.4). */
 int multifluid_iterative_pressure(multifluid_data *d, mf_sim *sim, double dt);
+
+/* multifluid_surface.c: surfaceTension's freeSurface pressure. The
+ * pressure phase with p = sigma kappa held on the free surface (eq. 18),
+ * and the correction (eq. 15) with the surface particles' own pressure. */
+int multifluid_surface_pressure_phase(multifluid_data *d, mf_sim *sim, double dt);
+int multifluid_surface_correction(multifluid_data *d, mf_sim *sim, double dt);
 
 #endif

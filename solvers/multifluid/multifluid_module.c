@@ -113,6 +113,14 @@ static int setup_fluids(multifluid_data *d, mf_sim *sim)
     return 0;
 }
 
+static void log_surface_pressure(const multifluid_data *d, const mf_sim *sim)
+{
+    if (d->surface_pressure)
+        mf_log_printf(sim->log, MF_LOG_NORMAL,
+                      "multiFluid: free-surface particles (eq. 18) hold the Laplace pressure "
+                      "sigma kappa (surfaceTension freeSurface pressure)\n");
+}
+
 static int create_data(const multifluid_settings *s, mf_sim *sim, const mf_dict *solver_dict,
                        multifluid_data *d)
 {
@@ -121,6 +129,8 @@ static int create_data(const multifluid_settings *s, mf_sim *sim, const mf_dict 
     d->f_light_pressure = -1;
     MF_CALL(mps_create_data(&d->s.mps, sim, solver_dict, &d->mps));
     if (d->f_fluid < 0) {
+        d->surface_pressure = mf_forces_claim_surface_pressure(sim);
+        log_surface_pressure(d, sim);
         if (sim->nfluids > 1)
             return MF_ERROR(MF_ERR_INTERNAL, "%d fluids but no FluidId field", sim->nfluids);
         mf_log_printf(sim->log, MF_LOG_NORMAL,
@@ -130,6 +140,10 @@ static int create_data(const multifluid_settings *s, mf_sim *sim, const mf_dict 
     }
     MF_CALL(check_fluid_ids(d, sim));
     MF_CALL(setup_fluids(d, sim));
+    /* The iterative solve holds other pressures on its Dirichlet particles:
+     * a module asking for the free-surface pressure stops with its message. */
+    d->surface_pressure = !d->iterative && mf_forces_claim_surface_pressure(sim);
+    log_surface_pressure(d, sim);
     MF_CALL(multifluid_reserve(d, sim->p->n));
     return 0;
 }

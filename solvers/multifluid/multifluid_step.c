@@ -48,11 +48,30 @@ void multifluid_fill_properties(multifluid_data *d, const mf_sim *sim)
     }
 }
 
+/* One fluid with the Laplace pressure on its free surface: the phases of
+ * mps_lagrangian_step, pressure and correction from multifluid_surface.c. */
+static int one_fluid_step(multifluid_data *d, mf_sim *sim, double dt)
+{
+    mps_data *m = d->mps;
+    MF_CALL(mps_reserve(m, sim->p->n));
+    MF_CALL(multifluid_reserve(d, sim->p->n));
+    MF_CALL(mps_build_neighbours(m, sim, true));
+    mps_set_masks(m, sim->p);
+    MF_CALL(mps_explicit_phase(m, sim, dt));
+    MF_CALL(mps_build_neighbours(m, sim, false));
+    MF_CALL(multifluid_surface_pressure_phase(d, sim, dt));
+    MF_CALL(multifluid_surface_correction(d, sim, dt));
+    return 0;
+}
+
 int multifluid_step(multifluid_data *d, mf_sim *sim, double dt)
 {
     mps_data *m = d->mps;
     if (d->f_fluid < 0) { /* one fluid: the MPS step itself */
-        MF_CALL(mps_lagrangian_step(m, sim, dt));
+        if (d->surface_pressure)
+            MF_CALL(one_fluid_step(d, sim, dt));
+        else
+            MF_CALL(mps_lagrangian_step(m, sim, dt));
         return 0;
     }
     mf_particles *p = sim->p;
@@ -68,6 +87,11 @@ int multifluid_step(multifluid_data *d, mf_sim *sim, double dt)
     MF_CALL(mps_build_neighbours(m, sim, false)); /* at r* */
     if (d->iterative) {
         MF_CALL(multifluid_iterative_pressure(d, sim, dt));
+        return 0;
+    }
+    if (d->surface_pressure) { /* p = sigma kappa on the free surface */
+        MF_CALL(multifluid_surface_pressure_phase(d, sim, dt));
+        MF_CALL(multifluid_surface_correction(d, sim, dt));
         return 0;
     }
     MF_CALL(mps_pressure_phase(m, sim, dt));   /* variable-density PPE, one solve */
