@@ -93,6 +93,11 @@ typedef struct mps_data {
     /* PPE: the pressure of particles that are not unknowns but take part
      * (non-dummy neighbours: free surface, or held by another solve); NULL: 0. */
     const double *p_dirichlet;
+    /* eq. 15 (gradientPmin): these particles take p^_i = p_i rather than the
+     * neighbourhood's minimum (surfaceTension's freeSurface pressure); NULL:
+     * none. */
+    const uint8_t *own_reference;
+    double rho_default;        /* sim->fluid[0].rho, where rho is NULL */
     const char *solve_name;    /* the log's "Solving for <name>"; NULL: p */
     /* PPE source against a per-particle reference: rhs ~ (n*_i - n0 - n_offset_i)/n0
      * (MPS-MAFL's densityReference startOfStep); NULL: none. */

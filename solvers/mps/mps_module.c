@@ -55,6 +55,7 @@ int mps_create_data(const mps_settings *s, mf_sim *sim, const mf_dict *solver_di
     MF_CALL(mf_kernel_init(&d->k_grad, sim->dim, sim->l0, s->re_gradient * sim->l0));
     MF_CALL(mf_kernel_init(&d->k_lap, sim->dim, sim->l0, s->re_laplacian * sim->l0));
     sim->n0 = d->k_nd.n0; /* the NumberDensity field's reference, for the run's watch */
+    d->rho_default = sim->fluid[0].rho;
     MF_CALL(mf_particles_request_field(sim->p, "Pressure", 1, MF_FIELD_DOUBLE, true,
                                        &d->f_pressure));
     MF_CALL(mf_particles_request_field(sim->p, "NumberDensity", 1, MF_FIELD_DOUBLE, true,

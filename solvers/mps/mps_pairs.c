@@ -52,7 +52,8 @@ void mps_viscous_pairs(const mps_data *d, const mf_particles *p, const mf_nlist 
 }
 
 /* eq. 15 with 1/rho_ij inside the gradient sum (eq. 5): the same pair
- * coefficient as the PPE, so the correction is the one the PPE solved for. */
+ * coefficient as the PPE, so the correction is the one the PPE solved for
+ * (1/rho with one fluid, rho NULL). */
 void mps_gradient_pairs(mps_data *d, const mf_particles *p, const double *pressure,
                         const uint8_t *imask)
 {
@@ -61,6 +62,8 @@ void mps_gradient_pairs(mps_data *d, const mf_particles *p, const double *pressu
     const double *rho = d->rho;
     const int avg = d->rho_average;
     const bool use_min = d->s.gradient_pmin;
+    const uint8_t *own = d->own_reference;
+    const double inv_rho0 = 1.0 / d->rho_default;
     double *grad = d->grad;
     const long np = (long)p->n_owned;
 #pragma omp parallel for schedule(static)
@@ -68,7 +71,7 @@ void mps_gradient_pairs(mps_data *d, const mf_particles *p, const double *pressu
         if (!d->is_fluid[i] || (imask && !imask[i]))
             continue;
         double pi = pressure[i];
-        if (use_min)
+        if (use_min && !(own && own[i]))
             for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
                 size_t j = nl->j[k];
                 if (d->not_dummy[j] && pressure[j] < pi)
@@ -82,8 +85,8 @@ void mps_gradient_pairs(mps_data *d, const mf_particles *p, const double *pressu
             double len = pair_vector(&p->pos[3 * i], &p->pos[3 * j], r);
             if (len <= 0.0)
                 continue; /* coincident particles carry no direction */
-            double s = (pressure[j] - pi) * mps_inv_rho_pair(rho[i], rho[j], avg) *
-                       mf_weight(len, re) / (len * len);
+            double inv_rho = rho ? mps_inv_rho_pair(rho[i], rho[j], avg) : inv_rho0;
+            double s = (pressure[j] - pi) * inv_rho * mf_weight(len, re) / (len * len);
             for (int c = 0; c < 3; c++)
                 g[c] += s * r[c];
         }
