@@ -534,6 +534,7 @@ static int add_nozzle(mf_sim *sim, mf_emitters *em, const char *name, const mf_d
     nz->offset = malloc(3 * cap * sizeof *nz->offset);
     if (!nz->offset)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory for nozzle '%s'", name);
+    em->nnozzles++; /* counted from here: on an error below, the cleanup frees its offsets */
     double a[3], b[3];
     if (sim->dim == 2) {
         a[0] = -nz->dir[1];
@@ -567,7 +568,6 @@ static int add_nozzle(mf_sim *sim, mf_emitters *em, const char *name, const mf_d
                         nz->speed * nz->period / l0, nz->speed, 2 * natural_rate);
     if (r)
         MF_CALL(mf_dict_set_number(r, "rate", nz->rate));
-    em->nnozzles++;
     return 0;
 }
 

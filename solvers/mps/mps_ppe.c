@@ -146,6 +146,20 @@ int mps_assemble_ppe(mps_data *d, const mf_sim *sim, double dt)
                     known += cw * pd[j];
             }
         }
+        if (!(sum > 0) && d->is_fluid[i]) {
+            /* n* counts dummy particles, the Laplacian does not: a fluid
+             * particle with only dummies within re is inside a wall, and its
+             * row would be zero (BoomerAMG stops on the singular system).
+             * Seen on a mesh wall, which the run's watch does not check. */
+            int rc = MF_ERROR(MF_ERR_NUMERIC,
+                              "unstable (throughWall) at time %g, step %ld: fluid particle id "
+                              "%lld at (%g %g %g) has only dummy particles within re: it is "
+                              "inside a wall",
+                              sim->time, sim->step, (long long)p->id[i], p->pos[3 * i],
+                              p->pos[3 * i + 1], p->pos[3 * i + 2]);
+            free(touches);
+            return rc;
+        }
         /* n* - n0, or against a per-particle reference (mps_data.n_offset) */
         const double dn = d->n_offset ? n[i] - n0 - d->n_offset[i] : n[i] - n0;
         if (rho_p) {
@@ -157,6 +171,13 @@ int mps_assemble_ppe(mps_data *d, const mf_sim *sim, double dt)
         }
         if (pd)
             d->rhs[r] += known;
+        if (!(sum > 0) && d->s.compressibility <= 0) {
+            /* A wall particle with only dummies within re: no equation
+             * couples it, so it takes p = 0 (a zero row is singular). */
+            A->val[diag] = c;
+            d->rhs[r] = 0;
+            touches[r] = 1;
+        }
         if (d->s.compressibility > 0)
             touches[r] = 1;
         d->x[r] = pressure[i]; /* warm start from the last step */
