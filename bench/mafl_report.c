@@ -69,7 +69,7 @@ static int run_one(const char *exe, const char *tutorial, const variant *v, doub
         snprintf(path, sizeof path, "%s/system/solverDict", dir);
         snprintf(text, sizeof text,
                  "solver MAFL;\nMAFLCoeffs\n{\n    reconfiguration fixed;\n    densityReference "
-                 "startOfStep;\n    convection { %s }\n}\npressure { solver PCG_BoomerAMG; "
+                 "divergence;\n    convection { %s }\n}\npressure { solver PCG_BoomerAMG; "
                  "tolerance 1e-10; }\n",
                  v->coeffs);
         rc = write_text(path, text);

@@ -23,8 +23,9 @@
  *      closest old point after step 3 (eq. 22).
  *
  * Free-surface points are those the MPS phase flags (eq. 18) whose
- * neighbours lie on one side; a flagged point with neighbours all round
- * (beside a gap at an inlet) keeps the interior rule.
+ * neighbours lie on one side and include no inlet or outlet point; a
+ * flagged point with neighbours all round, or beside the gap at an inlet,
+ * keeps the interior rule.
  *
  * Settings come from MAFLCoeffs: the MPS parameters (the same table as
  * MPSCoeffs), the reconfiguration rule, densityReference (the PPE source,
@@ -66,6 +67,7 @@ typedef struct mafl_settings {
     double remove_distance;    /* merge fluid points closer than this, in l0 (0: never) */
     double hole_distance;      /* a lattice site with no point this close (in l0) ... */
     double hole_density;       /* ... and number density >= this n0 is a hole */
+    bool hole_spacing;         /* a new point goes l0 from its nearest point */
 } mafl_settings;
 
 #define MAFL_MAX_CARRIED (3 + MF_MAX_SCALARS)
@@ -73,7 +75,8 @@ typedef struct mafl_settings {
 typedef struct mafl_data {
     mafl_settings s;
     mafl_rule rule;
-    bool incremental;          /* densityReference startOfStep */
+    bool incremental;          /* densityReference startOfStep or divergence */
+    bool linear_source;        /* densityReference divergence: every pair linearised */
     mps_data *mps;             /* the composed MPS solver */
     mf_module conv;            /* the convection scheme */
     const mf_convection_ops *conv_ops;
@@ -93,8 +96,7 @@ typedef struct mafl_data {
     size_t cap;
     double *pos_l;             /* 3n: r^L */
     /* densityReference startOfStep (mafl_lagrangian.c): */
-    double *n_eff;             /* n: the number density the source is taken from */
-    double *n_offset;          /* n: n* - n_eff, to restore NumberDensity */
+    double *n_offset;          /* n: n* - n_eff, the MPS module's source offset */
     double *pos_new;           /* 3n: r^{n+1} */
     double *value;             /* MAFL_MAX_CARRIED * n: new values, field-major */
     uint8_t *convected;        /* 1 if the Eulerian phase set the point's values */
@@ -107,7 +109,7 @@ typedef struct mafl_data {
 } mafl_data;
 
 extern const mf_solver_ops mf_solver_MAFL;
-#define MAFL_NPARAMS (MPS_NPARAMS + 13)
+#define MAFL_NPARAMS (MPS_NPARAMS + 14)
 extern const mf_param mafl_params[MAFL_NPARAMS];
 
 /* mafl_module.c */

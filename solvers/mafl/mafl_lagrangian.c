@@ -22,18 +22,29 @@
  *    of fixed points (where Lagrangian surface points meet fixed interior
  *    points) is no compression of the fluid, but with n0 it drives a
  *    spurious velocity every step.
- * The price: nothing pulls the free surface back to its volume. On a resting
- * box under gravity (rule fixed) startOfStep loses 40% of the fluid points
- * to merging in 2 s while n0 keeps them all (its spurious velocity levels
- * off near 0.17 m/s, pure MPS about 0.07 m/s). So startOfStep is for flows
- * without a free surface (channels: the tutorials scalarAdvection and
- * channelInflow use it), n0 for the rest. README (MPS-MAFL) has the numbers.
+ * densityReference divergence: the same, with the pairs of moving points
+ * linearised too, n_eff = n0 + sum_j (dw/dr)(r^n_ij/|r^n_ij|).(d_i - d_j),
+ * d = r* - r^n: the MPS divergence of this step's displacement, so the
+ * source is -(rho/dt) <div u*> (a velocity-divergence source). Why: the
+ * exact w(|r*_ij|) - w(|r^n_ij|) of startOfStep also has the second-order
+ * term of a shear, pairs pulled apart by (du/dy dt)^2, which reads as an
+ * expansion; in a channel it drove a steady flow into the walls and the
+ * flow rate fell by 9% over 1 m at l0 = H/10 (4.8% with dt halved: it is
+ * O(dt^2) a step), not falling with l0 at a fixed Courant number. With
+ * divergence the flow rate is the same at every section within 2e-4
+ * (tests/test_mafl.c, part continuity).
  *
- * The hook that would let this call mps_lagrangian_step unchanged: a
- * per-particle source offset in mps_data, rhs_i ~ (n_i - n0 - offset_i)/n0
- * (NULL: none). Until the MPS module has one, mafl_lagrangian mirrors the
- * sequence of mps_lagrangian_step and changes the NumberDensity values that
- * mps_assemble_ppe reads, restoring them after. */
+ * Both: nothing pulls a free surface back to its volume. On a resting box
+ * under gravity (rule fixed) startOfStep loses 40% of the fluid points to
+ * merging in 2 s while n0 keeps them all (its spurious velocity levels off
+ * near 0.17 m/s, pure MPS about 0.07 m/s). So these are for flows without
+ * a free surface (channels: the tutorials scalarAdvection and channelInflow
+ * use divergence), n0 for the rest. README (MPS-MAFL) has the numbers.
+ *
+ * The MPS module's hook does it: mps_data.n_offset (rhs ~ (n*_i - n0 -
+ * offset_i)/n0) with offset_i = n*_i - n_eff_i, filled by
+ * mps_data.before_assembly once the lists and n* at r* exist. The phase is
+ * then one call of mps_lagrangian_step in every case. */
 #include <math.h>
 #include <string.h>
 
@@ -51,10 +62,64 @@ static inline double dw_over_r(double r, double re)
     return (r > 0.0 && r < re) ? -re / (r * r * r) : 0.0;
 }
 
+/* Seen from i at r^n, its neighbours of the other sort (fixed ones for a
+ * moving i, moving ones for a fixed i): the wall normal, the direction from
+ * their centroid to i (smooth weight (1 - r/re)^2, so that it hardly
+ * depends on where i sits along the wall lattice), and for a fixed i the
+ * mean displacement of its moving neighbours. False if there are none. */
+static bool wall_frame(const mps_data *m, const mf_particles *p, const mf_nlist *nl,
+                       const double *xn, size_t i, double re, double nrm[3], double mean[3])
+{
+    const bool mi = m->is_fluid[i];
+    const double *xi0 = &xn[3 * i];
+    double c[3] = {0, 0, 0}, sw = 0;
+    memset(mean, 0, 3 * sizeof *mean);
+    for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
+        const size_t j = nl->j[k];
+        if (m->is_fluid[j] == mi)
+            continue;
+        const double *xj0 = &xn[3 * j], *xj = &p->pos[3 * j];
+        double r0[3] = {xi0[0] - xj0[0], xi0[1] - xj0[1], xi0[2] - xj0[2]};
+        double d0 = sqrt(r0[0] * r0[0] + r0[1] * r0[1] + r0[2] * r0[2]);
+        if (d0 >= re)
+            continue;
+        double w = (1.0 - d0 / re) * (1.0 - d0 / re);
+        sw += w;
+        for (int a = 0; a < 3; a++) {
+            c[a] += w * r0[a];
+            mean[a] += w * (xj[a] - xj0[a]);
+        }
+    }
+    double len = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    if (!(len > 0) || !(sw > 0))
+        return false;
+    for (int a = 0; a < 3; a++) {
+        nrm[a] = c[a] / len;
+        mean[a] /= sw;
+    }
+    return true;
+}
+
+static inline double dot3(const double a[3], const double b[3])
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
 /* n_eff at r* (lists at r*, r^n from the field xn): pairs of moving points
- * exactly, pairs with a fixed particle linearised at r^n. */
+ * exactly (linear false) or linearised like the rest (linear true); pairs
+ * of a moving and a fixed particle linearised at r^n, where a rigid
+ * motion along the wall counts only by its part normal to the wall
+ * (wall_frame): sliding along the wall lattice changes the wall part of n
+ * with the lattice's phase, which is no compression (with points that move,
+ * whole rows slide in step and that false source built up kPa over a 1 m
+ * channel). For a moving i that is its own displacement; for a wall
+ * particle i the mean displacement of its moving neighbours, their
+ * deformation (displacement minus the mean) counting in full. Only with
+ * project (rules that move interior points): fixed points sit where the
+ * wall lattice is symmetric, and in a corner the one normal is wrong (a
+ * resting box with a free surface lost 64% of its points in 2 s with it). */
 static void effective_density(const mps_data *m, const mf_particles *p, const double *xn,
-                              double *eff)
+                              bool linear, bool project, double *eff)
 {
     const mf_nlist *nl = nd_list(m);
     const double re = m->k_nd.re, n0 = m->k_nd.n0;
@@ -62,9 +127,11 @@ static void effective_density(const mps_data *m, const mf_particles *p, const do
 #pragma omp parallel for schedule(static)
     for (long ii = 0; ii < n; ii++) {
         const size_t i = (size_t)ii;
-        double sum = n0;
+        double sum = n0, nrm[3] = {0, 0, 0}, mean[3] = {0, 0, 0};
         const double *xi = &p->pos[3 * i], *xi0 = &xn[3 * i];
         const bool mi = m->is_fluid[i];
+        const bool wall = project && wall_frame(m, p, nl, xn, i, re, nrm, mean);
+        const double mean_n = dot3(mean, nrm);
         for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
             const size_t j = nl->j[k];
             const bool mj = m->is_fluid[j];
@@ -72,49 +139,54 @@ static void effective_density(const mps_data *m, const mf_particles *p, const do
                 continue;
             const double *xj = &p->pos[3 * j], *xj0 = &xn[3 * j];
             double r0[3] = {xi0[0] - xj0[0], xi0[1] - xj0[1], xi0[2] - xj0[2]};
-            double d0 = sqrt(r0[0] * r0[0] + r0[1] * r0[1] + r0[2] * r0[2]);
-            if (mi && mj) {
+            double d0 = sqrt(dot3(r0, r0));
+            double g = dw_over_r(d0, re);
+            /* The relative displacement (a fixed particle's is zero: x = x0). */
+            double rel[3];
+            for (int a = 0; a < 3; a++)
+                rel[a] = (xi[a] - xi0[a]) - (xj[a] - xj0[a]);
+            if (mi && mj && !linear) {
                 double r[3] = {xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]};
-                double d1 = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
-                sum += mf_weight(d1, re) - mf_weight(d0, re);
-            } else {
-                /* The moving one's displacement along the gradient of w. */
-                const double *x = mi ? xi : xj, *x0 = mi ? xi0 : xj0;
-                double g = dw_over_r(d0, re) * (mi ? 1.0 : -1.0);
+                sum += mf_weight(sqrt(dot3(r, r)), re) - mf_weight(d0, re);
+            } else if (mi && mj) {
+                sum += g * dot3(r0, rel);
+            } else if (wall && mi) {
+                sum += g * dot3(r0, nrm) * dot3(rel, nrm);
+            } else if (wall) { /* rel = -(displacement of j) */
+                double deform[3];
                 for (int a = 0; a < 3; a++)
-                    sum += g * r0[a] * (x[a] - x0[a]);
+                    deform[a] = rel[a] + mean[a];
+                sum += g * (dot3(r0, deform) - dot3(r0, nrm) * mean_n);
+            } else {
+                sum += g * dot3(r0, rel);
             }
         }
         eff[i] = sum;
     }
 }
 
+/* mps_data.before_assembly: offset_i = n*_i - n_eff_i for the unknowns. */
+static int source_offset(mps_data *m, mf_sim *sim, void *ctx)
+{
+    mafl_data *d = ctx;
+    const mf_particles *p = sim->p;
+    const double *n = mf_particles_fd(p, m->f_number_density);
+    const double *xn = mf_particles_fd(p, d->f_pos_n); /* r^n, reordered with the rest */
+    /* Only moving interior points slide along the walls in step. */
+    const bool project = d->rule != MAFL_RULE_FIXED;
+    effective_density(m, p, xn, d->linear_source, project, d->n_offset);
+    for (size_t i = 0; i < p->n_owned; i++)
+        d->n_offset[i] = m->in_ppe[i] ? n[i] - d->n_offset[i] : 0.0;
+    return 0;
+}
+
 int mafl_lagrangian(mafl_data *d, mf_sim *sim, double dt)
 {
-    if (!d->incremental)
-        return mps_lagrangian_step(d->mps, sim, dt);
     mps_data *m = d->mps;
-    mf_particles *p = sim->p;
-    MF_CALL(mps_reserve(m, p->n));
-    MF_CALL(mps_build_neighbours(m, sim, true)); /* at r^n; may reorder */
-    mps_set_masks(m, p);
-    MF_CALL(mps_explicit_phase(m, sim, dt));
-    MF_CALL(mps_build_neighbours(m, sim, false)); /* at r* */
-    MF_CALL(mps_surface_phase(m, sim));           /* free surface from the true n* */
-    double *n = mf_particles_fd(p, m->f_number_density);
-    const double *xn = mf_particles_fd(p, d->f_pos_n); /* r^n, reordered with the rest */
-    effective_density(m, p, xn, d->n_eff);
-    for (size_t i = 0; i < p->n_owned; i++) {
-        d->n_offset[i] = n[i] - d->n_eff[i]; /* kept to restore n* */
-        if (m->in_ppe[i])
-            n[i] = d->n_eff[i];
-    }
-    int rc = mps_assemble_ppe(m, sim, dt);
-    for (size_t i = 0; i < p->n_owned; i++) /* NumberDensity stays n*, as written */
-        if (m->in_ppe[i])
-            n[i] += d->n_offset[i];
-    MF_CALL(rc);
-    MF_CALL(mps_solve_ppe(m, sim));
-    MF_CALL(mps_correction_phase(m, sim, dt));
+    /* d->n_offset may have been reallocated since the last step. */
+    m->n_offset = d->incremental ? d->n_offset : NULL;
+    m->before_assembly = d->incremental ? source_offset : NULL;
+    m->before_assembly_ctx = d;
+    MF_CALL(mps_lagrangian_step(m, sim, dt));
     return 0;
 }

@@ -16,16 +16,14 @@ int mafl_reserve(mafl_data *d, size_t n)
     free(d->value);
     free(d->convected);
     free(d->remove);
-    free(d->n_eff);
     free(d->n_offset);
-    d->n_eff = malloc(cap * sizeof *d->n_eff);
     d->n_offset = malloc(cap * sizeof *d->n_offset);
     d->pos_l = malloc(3 * cap * sizeof *d->pos_l);
     d->pos_new = malloc(3 * cap * sizeof *d->pos_new);
     d->value = malloc(MAFL_MAX_CARRIED * cap * sizeof *d->value);
     d->convected = malloc(cap);
     d->remove = malloc(cap);
-    if (!d->n_eff || !d->n_offset || !d->pos_l || !d->pos_new || !d->value || !d->convected || !d->remove) {
+    if (!d->n_offset || !d->pos_l || !d->pos_new || !d->value || !d->convected || !d->remove) {
         d->cap = 0;
         return MF_ERROR(MF_ERR_MEMORY, "MPS-MAFL: out of memory for %zu points", n);
     }
@@ -62,7 +60,6 @@ static void mafl_destroy_data(mafl_data *d)
     free(d->value);
     free(d->convected);
     free(d->remove);
-    free(d->n_eff);
     free(d->n_offset);
     free(d);
 }
@@ -73,7 +70,8 @@ static int create_data(mafl_data *d, mf_sim *sim, const mf_dict *solver_dict)
     for (int r = 0; r < 4; r++)
         if (strcmp(d->s.reconfiguration, rule_names[r]) == 0)
             d->rule = (mafl_rule)r;
-    d->incremental = strcmp(d->s.density_reference, "startOfStep") == 0;
+    d->linear_source = strcmp(d->s.density_reference, "divergence") == 0;
+    d->incremental = d->linear_source || strcmp(d->s.density_reference, "startOfStep") == 0;
     mf_grid_init(&d->grid);
     MF_CALL(mps_create_data(&d->s.mps, sim, solver_dict, &d->mps));
     MF_CALL(create_convection(d, sim));

@@ -6,7 +6,7 @@
 #include "mafl.h"
 
 static const char *const rules[] = {"fixed", "fraction", "relax", "lagrangian", NULL};
-static const char *const references[] = {"n0", "startOfStep", NULL};
+static const char *const references[] = {"n0", "startOfStep", "divergence", NULL};
 
 #define MAFL_MPS_OFFSET(field) offsetof(mafl_settings, mps.field)
 #define MAFL_OFFSET(field) offsetof(mafl_settings, field)
@@ -20,8 +20,9 @@ const mf_param mafl_params[MAFL_NPARAMS] = {
     {"densityReference", MF_PARAM_WORD, "n0", MF_NO_RANGE, references,
      MAFL_OFFSET(density_reference),
      "source of the pressure equation: n0, (n* - n0)/n0 as in MPS; startOfStep, the "
-     "compression of this step's motion only (for flows without a free surface: a uniform "
-     "flow along walls stays exactly uniform)"},
+     "compression of this step's motion only; divergence, the same linearised in every pair "
+     "(-rho/dt <div u*>: keeps the flow rate along a channel). The last two are for flows "
+     "without a free surface: a uniform flow along walls stays exactly uniform"},
     {"fraction", MF_PARAM_SCALAR, "0.5", 0, 1, NULL, MAFL_OFFSET(fraction),
      "rule fraction: interior points move this share of their Lagrangian displacement"},
     {"shift", MF_PARAM_SCALAR, "0.05", 0, 1, NULL, MAFL_OFFSET(shift),
@@ -44,7 +45,10 @@ const mf_param mafl_params[MAFL_NPARAMS] = {
      "of two fluid points closer than this (in l0) the newer is removed (0: never)"},
     {"holeDistance", MF_PARAM_SCALAR, "0.9", 0.5, 2, NULL, MAFL_OFFSET(hole_distance),
      "a lattice site with no point within this (in l0) ..."},
-    {"holeDensity", MF_PARAM_SCALAR, "0.85", 0.3, 1, NULL, MAFL_OFFSET(hole_density),
+    {"holeDensity", MF_PARAM_SCALAR, "0.75", 0.3, 1, NULL, MAFL_OFFSET(hole_density),
      "... and at least this share of a full lattice site's neighbours within reNumberDensity "
      "is a hole"},
+    {"holeSpacing", MF_PARAM_BOOL, "yes", MF_NO_RANGE, NULL, MAFL_OFFSET(hole_spacing),
+     "a new point goes l0 from its nearest point (along the line through the site) rather "
+     "than onto the lattice site: holes found late by up to |u^c| dt are not packed"},
 };

@@ -106,12 +106,13 @@ static double full_count(int dim, double re, double l0)
 /* Is the site x a hole? No point closer than holeDistance, and at least
  * holeDensity of a full lattice's neighbours within re (a count, not the
  * singular weight: one close point must not make an empty site look full).
- * Then *closest is the nearest point carrying values. */
+ * Then *closest is the nearest point carrying values and *nearest the
+ * nearest point of any kind. */
 static bool is_hole(const mafl_data *d, const mf_particles *p, const double x[3], double l0,
-                    double full, size_t *closest)
+                    double full, size_t *closest, size_t *nearest)
 {
     const double dmin = d->s.hole_distance * l0, re = d->mps->k_nd.re;
-    double count = 0, best = INFINITY;
+    double count = 0, best = INFINITY, best_any = INFINITY;
     long cells[27];
     int nc = mafl_cells_near(&d->grid, x, cells);
     for (int c = 0; c < nc; c++)
@@ -126,12 +127,34 @@ static bool is_hole(const mafl_data *d, const mf_particles *p, const double x[3]
                 return false;
             if (r < re)
                 count++;
+            if (r < best_any) {
+                best_any = r;
+                *nearest = j;
+            }
             if (carries_values(p->kind[j]) && r < best) {
                 best = r;
                 *closest = j;
             }
         }
     return isfinite(best) && count >= d->s.hole_density * full;
+}
+
+/* A hole is found the first step its nearest point is more than
+ * holeDistance l0 away, so a site filled at once would be between
+ * holeDistance and holeDistance + |u^c| dt from it: where points stream
+ * away from an inlet that packed the new columns about 0.95 l0 apart and
+ * the count grew. The new point goes to l0 from its nearest point instead,
+ * along the line from that point through the site (a shift of at most
+ * (1 - holeDistance) l0). */
+static void space_from_nearest(const mf_particles *p, size_t nearest, double l0, double x[3])
+{
+    const double *xn = &p->pos[3 * nearest];
+    double r[3] = {x[0] - xn[0], x[1] - xn[1], x[2] - xn[2]};
+    double len = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+    if (!(len > 0) || len >= l0)
+        return;
+    for (int a = 0; a < 3; a++)
+        x[a] = xn[a] + r[a] * (l0 / len);
 }
 
 /* Candidate sites: around fluid points whose number density (at r*, from
@@ -181,9 +204,11 @@ static int find_holes(mafl_data *d, const mf_sim *sim, hole **out, size_t *nout)
             continue;
         double x[3];
         site_position(d, dim, keys[k], l0, x);
-        size_t closest = 0;
-        if (!is_hole(d, p, x, l0, full, &closest))
+        size_t closest = 0, nearest = 0;
+        if (!is_hole(d, p, x, l0, full, &closest, &nearest))
             continue;
+        if (d->s.hole_spacing)
+            space_from_nearest(p, nearest, l0, x);
         if (nholes == hcap) {
             hcap = 2 * hcap + 64;
             hole *grown = realloc(holes, hcap * sizeof *holes);

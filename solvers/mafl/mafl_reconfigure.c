@@ -161,8 +161,11 @@ static void relax_shift(const mafl_data *d, const mf_sim *sim, size_t i, double 
  * or where points are sparse. Such a point moving with the full flow would
  * catch up with the interior points ahead and merge with them. A point on a
  * free surface has all its neighbours on one side: the centroid of its
- * neighbours within reInterpolation lies more than a fifth of l0 away. */
-static bool one_sided(const mafl_data *d, const mf_sim *sim, size_t i)
+ * neighbours within reInterpolation lies more than a fifth of l0 away; and
+ * no inlet or outlet point is among them (the first column beside an
+ * inlet's gap is one-sided by that test, and moving with the full flow it
+ * packed the points after it to about 0.75 l0). */
+static bool one_sided(const mafl_data *d, const mf_sim *sim, const int32_t *kind0, size_t i)
 {
     const double *xi = &d->pos_l[3 * i], re = d->s.re_interpolation * sim->l0;
     double sum[3] = {0, 0, 0};
@@ -177,6 +180,8 @@ static bool one_sided(const mafl_data *d, const mf_sim *sim, size_t i)
             double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
             if (j == i || r2 >= re * re)
                 continue;
+            if (kind0[j] == MF_INLET || kind0[j] == MF_OUTLET)
+                return false;
             for (int a = 0; a < 3; a++)
                 sum[a] += r[a];
             count++;
@@ -207,7 +212,7 @@ int mafl_reconfigure(mafl_data *d, mf_sim *sim, double dt)
         if (kind0[i] != MF_FLUID) {
             /* Walls, dummies, inlets and outlets return to r^n. */
             memcpy(out, a, 3 * sizeof *out);
-        } else if ((flags[i] & MPS_FLAG_SURFACE) && one_sided(d, sim, (size_t)i)) {
+        } else if ((flags[i] & MPS_FLAG_SURFACE) && one_sided(d, sim, kind0, (size_t)i)) {
             /* Free surface: Lagrangian, re-spaced along the surface. */
             if (d->s.surface_shift > 0)
                 surface_shift(d, sim, (size_t)i, kind0, flags, shift);

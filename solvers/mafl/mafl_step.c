@@ -55,6 +55,20 @@ static void restore_kinds(mafl_data *d, mf_particles *p)
         p->kind[i] = (uint8_t)kind0[i];
 }
 
+/* Inlet points are boundary values: what the Eulerian phase reads from them
+ * is the prescribed velocity, not the one the Lagrangian phase gave them
+ * (the pressure drop across the inlet buffer changes it by up to 2% a step
+ * at Courant number 0.2; in a channel at l0 = H/10 this won back 0.05% of
+ * the inflow). */
+static void restore_inlet_velocity(mafl_data *d, mf_particles *p)
+{
+    const int32_t *kind0 = mf_particles_fi(p, d->f_kind);
+    const double *un = mf_particles_fd(p, d->f_vel_n);
+    for (size_t i = 0; i < p->n; i++)
+        if (kind0[i] == MF_INLET)
+            memcpy(&p->vel[3 * i], &un[3 * i], 3 * sizeof *un);
+}
+
 /* r^{n+1} and the convected values become the particles' state; inlet
  * points keep their prescribed velocity. */
 static void commit(mafl_data *d, mf_sim *sim)
@@ -103,6 +117,7 @@ int mafl_step(mafl_data *d, mf_sim *sim, double dt)
     d->t_reconfigure += t2 - t1;
 
     /* 3. Eulerian phase: every carried field to r^{n+1}. */
+    restore_inlet_velocity(d, p);
     MF_CALL(mafl_eulerian(d, sim, dt));
     commit(d, sim);
     double t3 = mf_wall_seconds();

@@ -102,6 +102,12 @@ typedef struct mps_data {
     /* PPE source against a per-particle reference: rhs ~ (n*_i - n0 - n_offset_i)/n0
      * (MPS-MAFL's densityReference startOfStep); NULL: none. */
     const double *n_offset;
+    /* Called by mps_pressure_phase between the surface phase (n* and the
+     * unknowns known, lists at r*) and the assembly, for a composing solver
+     * to fill n_offset from r* (MPS-MAFL's densityReference startOfStep);
+     * NULL: nothing. */
+    int (*before_assembly)(struct mps_data *d, mf_sim *sim, void *ctx);
+    void *before_assembly_ctx;
 } mps_data;
 
 enum { MPS_FLAG_SURFACE = 1 }; /* bits of the Flags field */

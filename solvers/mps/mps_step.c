@@ -173,10 +173,20 @@ int mps_surface_phase(mps_data *d, mf_sim *sim)
     return 0;
 }
 
+/* A composing solver's hook before the assembly (mps_data.before_assembly). */
+static int run_before_assembly(mps_data *d, mf_sim *sim)
+{
+    if (!d->before_assembly)
+        return 0;
+    MF_CALL(d->before_assembly(d, sim, d->before_assembly_ctx));
+    return 0;
+}
+
 /* eqs. 11-14 and 18: number density at r*, free surface, PPE. */
 int mps_pressure_phase(mps_data *d, mf_sim *sim, double dt)
 {
     MF_CALL(mps_surface_phase(d, sim));
+    MF_CALL(run_before_assembly(d, sim));
     MF_CALL(mps_assemble_ppe(d, sim, dt));
     MF_CALL(mps_solve_ppe(d, sim));
     return 0;
