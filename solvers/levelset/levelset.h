@@ -55,7 +55,7 @@ typedef struct ls_settings {
     double alpha, beta;    /* eq. 29 */
     const char *integrator; /* "explicit" (ERKStep) or "imex" (ARKStep, SPGMR); read at create */
     double tolerance;      /* converged: |d phi / d tau| on the surface below this, cells */
-    double rel_tol, abs_tol; /* ARKODE's local error tolerances */
+    double rel_tol, abs_tol; /* ARKODE's tolerances (IMEX's Newton iterations) */
     long max_steps;        /* ARKODE steps per frame */
     double max_pseudo_time; /* per frame */
     long band_width;       /* half-width of the evolved band, cells */
@@ -241,6 +241,9 @@ int ls_band_link(ls_band *band);
 int ls_band_from_seeds(ls_band *band, const ls_seed *seeds, size_t nseeds);
 /* Points with a face neighbour of the other sign (phi > 0 inside). */
 int ls_band_interface(const ls_band *band, ls_seed **seeds, size_t *n);
+/* The points with |phi| <= dist, as seeds (a warm start keeps the previous
+ * frame's evolved values, not only its interface). */
+int ls_band_within(const ls_band *band, double dist, ls_seed **seeds, size_t *n);
 /* Seeds from a field's sign changes: sub-cell distance along the axes. */
 int ls_crossing_seeds(const ls_crossing *c, ls_seed **seeds, size_t *n);
 /* F at every point of the band's bricks that lacks it: copied from the same
@@ -290,6 +293,10 @@ int ls_rhs_precond_setup(ls_rhs *r, const double *y, double gamma);
 void ls_rhs_precond_solve(ls_rhs *r, const double *rhs, double *z);
 /* The largest stable explicit step: advection (and curvature if `curvature`). */
 double ls_rhs_stable_step(const ls_rhs *r, bool curvature);
+/* Bounds of the spectrum of eq. 29's linearisation for the speed bound fmax:
+ * the curvature term's eigenvalues lie on [-curv, 0], the upwind advection
+ * term's in the disk |z + adv| <= adv. */
+void ls_rhs_spectrum(const ls_rhs *r, double fmax, double *curv, double *adv);
 
 /* ---- ARKODE glue (ls_arkode.c) ------------------------------------------- */
 
@@ -299,6 +306,9 @@ typedef struct ls_stats {
     long newton_iters, newton_fails, lin_iters, lin_fails;
     long rebuilds;
     long rhs_calls;        /* calls of our right-hand side (any part), counted here */
+    long redone;           /* explicit: chunks redone with a larger spectrum bound */
+    int stages;            /* explicit: stages of the last RKC table */
+    double step;           /* explicit: its fixed pseudo-time step */
     double pseudo_time;
     double last_change;    /* the convergence measure at the end */
     bool converged;
@@ -352,7 +362,8 @@ typedef struct ls_data {
     bool have_previous;
     double prev_h;
     ls_stats last;         /* the last frame's statistics */
-    double t_field, t_detect, t_band, t_evolve, t_mesh;
+    double t_field, t_detect, t_band, t_evolve, t_mesh; /* wall, s */
+    double c_field, c_detect, c_band, c_evolve, c_mesh; /* CPU (all threads), s */
     size_t peak_band_bytes;
 } ls_data;
 
@@ -361,6 +372,9 @@ int ls_frame(ls_data *d, const mf_sim *sim, mf_mesh *out);
 /* ---- helpers ------------------------------------------------------------- */
 
 double ls_seconds(void);
+/* CPU time of the process, all threads (the machine may be shared: wall
+ * time alone does not say what a frame costs). */
+double ls_cpu_seconds(void);
 /* The grid spacing a setting gives (0: l0 / 2). */
 static inline double ls_grid_spacing(double setting, double l0)
 {

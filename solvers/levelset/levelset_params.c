@@ -31,15 +31,16 @@ const mf_param ls_params[LS_NPARAMS] = {
      "weight of the mean curvature (made dimensionless with l0) in eq. 29"},
     {"integrator", MF_PARAM_WORD, "explicit", MF_NO_RANGE, integrators,
      offsetof(ls_settings, integrator),
-     "pseudo-time integration: explicit (ARKODE ERKStep) or imex (ARKStep, curvature implicit, "
-     "SPGMR)"},
+     "pseudo-time integration: explicit (ARKODE ERKStep, damped Chebyshev stages at fixed "
+     "steps) or imex (ARKStep, curvature implicit, SPGMR)"},
     {"tolerance", MF_PARAM_SCALAR, "0.03", 1e-8, 10, NULL, offsetof(ls_settings, tolerance),
      "converged when |d phi / d tau| within a cell of the surface falls below this (cells per "
      "unit pseudo-time)"},
     {"relTol", MF_PARAM_SCALAR, "1e-3", 1e-10, 1, NULL, offsetof(ls_settings, rel_tol),
-     "ARKODE relative tolerance of the pseudo-time steps"},
+     "ARKODE relative tolerance (imex: of the Newton iterations; explicit runs at fixed, "
+     "stability-chosen steps and has no error test)"},
     {"absTol", MF_PARAM_SCALAR, "1e-3", 1e-12, 10, NULL, offsetof(ls_settings, abs_tol),
-     "ARKODE absolute tolerance of the pseudo-time steps, grid cells"},
+     "ARKODE absolute tolerance, grid cells (imex: of the Newton iterations)"},
     {"maxSteps", MF_PARAM_INT, "20000", 1, 1e9, NULL, offsetof(ls_settings, max_steps),
      "ARKODE steps per frame at most"},
     {"maxPseudoTime", MF_PARAM_SCALAR, "50", 0.5, 1e9, NULL,

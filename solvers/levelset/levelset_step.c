@@ -4,9 +4,9 @@
  *   2. the bricks its zero level crosses (ls_detect.c);
  *   3. seeds of the band: the first frame starts from F = 0 (the points next
  *      to its zero level, at their sub-cell distance); a later frame starts
- *      from the previous frame's phi (its points next to the zero level keep
- *      their values: no re-initialisation, so consecutive surfaces are
- *      continuous). Where the fluid has moved by more than about a brick (8
+ *      from the previous frame's phi (its evolved points, |phi| <= band
+ *      width, keep their values: no re-initialisation, so consecutive
+ *      surfaces are continuous; only the rim is marched again). Where the fluid has moved by more than about a brick (8
  *      cells) since the last frame, or has appeared, the old surface has no
  *      F-crossing near it and the new F-crossing no old surface near it: there
  *      the frame starts from F = 0 locally;
@@ -42,14 +42,16 @@ static inline bool seed_in(const ls_bricks *set, const ls_seed *s)
            LS_NONE;
 }
 
-/* Seeds of a warm start: the old interface points near the new F crossing,
- * plus the F seeds far from any kept old point. */
+/* Seeds of a warm start: the old evolved points (|phi| <= band width) near
+ * the new F crossing, plus the F seeds far from any kept old point. Keeping
+ * the evolved values, not only the interface's, leaves less to march (the
+ * rim only) and starts the band where the last frame's evolution left it. */
 static int warm_seeds(const ls_band *old, const ls_crossing *cross, const ls_seed *fs,
                       size_t nfs, ls_seed **out, size_t *nout, size_t *nkept, size_t *nnew)
 {
     ls_seed *os = NULL;
     size_t nos = 0;
-    MF_CALL(ls_band_interface(old, &os, &nos));
+    MF_CALL(ls_band_within(old, old->width, &os, &nos));
     ls_bricks near_cross, kept_bricks, near_kept;
     ls_bricks_init(&near_cross);
     ls_bricks_init(&kept_bricks);
@@ -120,10 +122,10 @@ static void log_frame(const ls_data *d, const mf_sim *sim, double h, const ls_fi
                       st->newton_fails, st->lin_iters, st->lin_fails);
     else
         mf_log_printf(log, MF_LOG_NORMAL,
-                      "levelSet ERKStep (Heun-Euler 2(1)): %ld steps (%ld stability-limited, "
-                      "%ld accuracy-limited), %ld error-test failures, %ld right-hand sides\n",
-                      st->steps, st->steps_stability, st->steps_accuracy, st->error_fails,
-                      st->rhs_explicit);
+                      "levelSet ERKStep (damped Chebyshev RKC, %d stages at fixed steps of "
+                      "%.3g): %ld steps, %ld right-hand sides, %ld chunks redone with a "
+                      "smaller step\n",
+                      st->stages, st->step, st->steps, st->rhs_explicit, st->redone);
     mf_log_printf(log, st->converged ? MF_LOG_NORMAL : MF_LOG_QUIET,
                   "levelSet: %s after pseudo-time %.4g: |dphi/dtau| near the surface %.3g "
                   "cells, tolerance %g\n",
@@ -132,10 +134,11 @@ static void log_frame(const ls_data *d, const mf_sim *sim, double h, const ls_fi
                                                 "state)",
                   st->pseudo_time, st->last_change, d->s.tolerance);
     mf_log_printf(log, MF_LOG_NORMAL,
-                  "levelSet: mesh of %zu vertices and %zu triangles; seconds: field %.3f, zero "
-                  "level %.3f, band %.3f, evolution %.3f, mesh %.3f\n",
-                  out->nverts, out->ntris, d->t_field, d->t_detect, d->t_band, d->t_evolve,
-                  d->t_mesh);
+                  "levelSet: mesh of %zu vertices and %zu triangles; seconds wall (CPU, all "
+                  "threads): field %.3f (%.3f), zero level %.3f (%.3f), band %.3f (%.3f), "
+                  "evolution %.3f (%.3f), mesh %.3f (%.3f)\n",
+                  out->nverts, out->ntris, d->t_field, d->c_field, d->t_detect, d->c_detect,
+                  d->t_band, d->c_band, d->t_evolve, d->c_evolve, d->t_mesh, d->c_mesh);
 }
 
 int ls_frame(ls_data *d, const mf_sim *sim, mf_mesh *out)
@@ -158,17 +161,21 @@ int ls_frame(ls_data *d, const mf_sim *sim, mf_mesh *out)
     bool warm = false;
     int rc = 0;
 
-    double t = ls_seconds();
+    double t = ls_seconds(), c = ls_cpu_seconds();
     MF_CALL_GOTO(rc, ls_field_setup(&f, sim->p, LS_KERNEL_LEVELSET, h, l0, s->radius, s->cutoff,
                                     (double)s->kernel_power, s->threshold, s->anisotropic, limit,
                                     what),
                  done);
     d->t_field = ls_seconds() - t;
+    d->c_field = ls_cpu_seconds() - c;
     t = ls_seconds();
+    c = ls_cpu_seconds();
     MF_CALL_GOTO(rc, ls_detect(&f, l0, limit, &cross), done);
     d->t_detect = ls_seconds() - t;
+    d->c_detect = ls_cpu_seconds() - c;
 
     t = ls_seconds();
+    c = ls_cpu_seconds();
     MF_CALL_GOTO(rc, ls_crossing_seeds(&cross, &fs, &nfs), done);
     warm = s->warm_start && d->have_previous && d->prev_h == h && d->band.b.n > 0;
     if (warm) {
@@ -192,8 +199,10 @@ int ls_frame(ls_data *d, const mf_sim *sim, mf_mesh *out)
     MF_CALL_GOTO(rc, ls_band_from_seeds(&band, seeds, nseeds), done);
     MF_CALL_GOTO(rc, ls_band_fill_F(&band, &f, &cross.b, cross.F), done);
     d->t_band = ls_seconds() - t;
+    d->c_band = ls_cpu_seconds() - c;
 
     t = ls_seconds();
+    c = ls_cpu_seconds();
     ls_evolve_opts o = {
         .imex = d->imex,
         .alpha = s->alpha,
@@ -206,10 +215,13 @@ int ls_frame(ls_data *d, const mf_sim *sim, mf_mesh *out)
     };
     MF_CALL_GOTO(rc, ls_evolve(&band, &f, &o, &d->last), done);
     d->t_evolve = ls_seconds() - t;
+    d->c_evolve = ls_cpu_seconds() - c;
 
     t = ls_seconds();
+    c = ls_cpu_seconds();
     MF_CALL_GOTO(rc, ls_mesh_extract(&band.b, band.nb, NULL, band.phi, band.flag, h, out), done);
     d->t_mesh = ls_seconds() - t;
+    d->c_mesh = ls_cpu_seconds() - c;
     if (ls_band_memory(&band) > d->peak_band_bytes)
         d->peak_band_bytes = ls_band_memory(&band);
     log_frame(d, sim, h, &f, &cross, &band, warm, nkept, nnew, out);

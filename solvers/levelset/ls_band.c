@@ -283,6 +283,39 @@ static int fmm_accept(fmm *m, uint32_t h)
     return 0;
 }
 
+/* Sort n handles by brick (counting sort on handle / 512, nbricks bricks);
+ * count and tmp are scratch arrays grown as needed. */
+static int sort_by_brick(uint32_t *h, size_t n, size_t nbricks, size_t **count, size_t *ncount,
+                         uint32_t **tmp, size_t *ntmp)
+{
+    if (n < 2)
+        return 0;
+    if (*ncount < nbricks + 1) {
+        size_t *c = realloc(*count, (nbricks + 1) * sizeof *c);
+        if (!c)
+            return MF_ERROR(MF_ERR_MEMORY, "out of memory in fast marching");
+        *count = c;
+        *ncount = nbricks + 1;
+    }
+    if (*ntmp < n) {
+        uint32_t *t = realloc(*tmp, n * sizeof *t);
+        if (!t)
+            return MF_ERROR(MF_ERR_MEMORY, "out of memory in fast marching");
+        *tmp = t;
+        *ntmp = n;
+    }
+    size_t *c = *count;
+    memset(c, 0, (nbricks + 1) * sizeof *c);
+    for (size_t i = 0; i < n; i++)
+        c[h[i] / LS_B3 + 1]++;
+    for (size_t b = 0; b < nbricks; b++)
+        c[b + 1] += c[b];
+    for (size_t i = 0; i < n; i++)
+        (*tmp)[c[h[i] / LS_B3]++] = h[i];
+    memcpy(h, *tmp, n * sizeof *h);
+    return 0;
+}
+
 int ls_band_from_seeds(ls_band *band, const ls_seed *seeds, size_t nseeds)
 {
     ls_band_clear(band);
@@ -313,7 +346,17 @@ int ls_band_from_seeds(ls_band *band, const ls_seed *seeds, size_t nseeds)
         rc = MF_ERROR(MF_ERR_MEMORY, "too many bricks in the band (%zu)", band->b.n);
     for (size_t k = 0; k < nseeds && rc == 0; k++)
         rc = fmm_accept(&m, hs[k]);
+    size_t *count = NULL, ncount = 0;
+    uint32_t *sorted = NULL;
+    size_t nsorted = 0;
     for (size_t bk = 0; bk < m.q.nb && rc == 0; bk++) {
+        /* A bucket holds points from all over the surface: processed in the
+         * order they came, each access would miss the cache. Sorted by brick
+         * first (a counting sort; the order within a bucket is free, its
+         * points are within the bucket width of each other), the accesses
+         * stay within a few bricks at a time. */
+        rc = sort_by_brick(m.q.items[bk], m.q.n[bk], band->b.n, &count, &ncount, &sorted,
+                           &nsorted);
         /* items may be appended to this very bucket while it is processed */
         for (size_t i = 0; i < m.q.n[bk] && rc == 0; i++) {
             uint32_t h = m.q.items[bk][i];
@@ -326,6 +369,8 @@ int ls_band_from_seeds(ls_band *band, const ls_seed *seeds, size_t nseeds)
         m.q.n[bk] = m.q.cap[bk] = 0;
     }
     free(hs);
+    free(count);
+    free(sorted);
     queue_free(&m.q);
     if (rc == 0) {
         for (size_t q = 0; q < band->b.n * LS_B3; q++)
@@ -452,6 +497,28 @@ int ls_band_interface(const ls_band *band, ls_seed **seeds, size_t *n)
                         rc = seed_push(&l, LS_B * bc[0] + i, LS_B * bc[1] + j, LS_B * bc[2] + k,
                                        band->phi[o]);
                 }
+    }
+    if (rc != 0) {
+        free(l.s);
+        return rc;
+    }
+    *seeds = l.s;
+    *n = l.n;
+    return 0;
+}
+
+int ls_band_within(const ls_band *band, double dist, ls_seed **seeds, size_t *n)
+{
+    seed_list l = {0};
+    int rc = 0;
+    for (size_t b = 0; b < band->b.n && rc == 0; b++) {
+        const int32_t *bc = &band->b.coord[3 * b];
+        for (int q = 0; q < LS_B3 && rc == 0; q++) {
+            size_t o = b * LS_B3 + (size_t)q;
+            if ((band->flag[o] & LS_HAS_PHI) && fabs(band->phi[o]) <= dist)
+                rc = seed_push(&l, LS_B * bc[0] + (q & 7), LS_B * bc[1] + ((q >> 3) & 7),
+                               LS_B * bc[2] + (q >> 6), band->phi[o]);
+        }
     }
     if (rc != 0) {
         free(l.s);
