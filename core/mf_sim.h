@@ -72,6 +72,9 @@ typedef struct mf_sim {
     mf_wall_box *wall_boxes;
     /* n0 of the solver's number density (0: the solver has none), for the watch. */
     double n0;
+    /* Set by a solver that treats viscosity implicitly: the time loop then
+     * applies no viscous (maxDi) limit to the step. */
+    bool viscosity_implicit;
     const mf_registry *reg;
     mf_log *log;
     /* Statistics the driver reports (filled by modules). */

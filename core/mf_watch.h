@@ -5,12 +5,21 @@
  *   throughWall   a fluid particle past the wall-particle line of a closed
  *                 face of a wall box (fluid centres stay about l0/2 inside);
  *   densityCollapse  the mean number density of the fluid below a fraction
- *                 of n0 (the fluid has blown apart);
+ *                 of n0, or of its value at the start when that is lower (a
+ *                 thin sheet, a spray, a single particle start below n0: the
+ *                 fluid has blown apart when it thins from where it was);
  *   energy        kinetic energy growing without a source: KE - KE0 - W,
  *                 W the work of the force modules (gravity, surface tension,
  *                 ...) integrated over the run, above a fraction of the
- *                 run's energy scale KE0 + |W| + sum m |a_ext| L.
- * A pressure solve that diverges is reported by the solver itself. A check
+ *                 run's energy scale KE0 + |W| + sum m |a_ext| L + sigma S
+ *                 (S: the surface of the fluid's bounding box at the start;
+ *                 surface tension applied as a pressure condition does work
+ *                 no force module reports).
+ * A pressure solve that diverges or does not converge is reported by the
+ * solver itself, in the same form: `unstable (pressureSolve) at time ...`
+ * with the particle of the largest residual (solvers/mps/mps_ppe.c); a step
+ * that the limits shrink below minDeltaT is `unstable (timeStep)` (core/run.c).
+ * A check
  * that fires fails the step with MF_ERR_NUMERIC and a message that names
  * the criterion, the time and the particle (the time loop retries with a
  * smaller step, then stops and keeps the last good state).
@@ -37,6 +46,7 @@ typedef struct mf_watch {
     double work;         /* work of the force modules since then */
     double pot_scale;    /* sum m |a_ext| L at the start */
     double power;        /* force power at the last accepted step */
+    double n_start;      /* mean fluid number density at the first check (-1: not yet) */
     double *acc;         /* scratch: force accelerations, 3 per particle */
     size_t cap;
     /* Candidate values of the step being checked (committed on accept). */

@@ -133,7 +133,8 @@ static int diagnose_collapse(const mf_sim *sim, double dt, double floor_dt, cons
     }
     const double *x = &p->pos[3 * fastest];
     return MF_ERROR(MF_ERR_NUMERIC,
-                    "unstable: the time step fell to %g s (%s limit), below minDeltaT %g s, at "
+                    "unstable (timeStep): the time step fell to %g s (%s limit), below "
+                    "minDeltaT %g s, at "
                     "time %g: particle id %lld at (%g %g %g) moves at %g m/s. A pressure "
                     "spike feeds back through the Courant limit: try relaxation 0.2, the "
                     "collision model, or a fixed deltaT",
@@ -153,7 +154,8 @@ static int choose_dt(mf_run *run, double next_write, double *dt, const char **li
         *limiter = "fixed";
     } else {
         mf_dt_choice ch;
-        mf_dt_choose(sim->l0, mf_max_fluid_speed(sim->p), c->max_co, max_fluid_nu(sim),
+        mf_dt_choose(sim->l0, mf_max_fluid_speed(sim->p), c->max_co,
+                     sim->viscosity_implicit ? 0.0 : max_fluid_nu(sim),
                      c->max_di, c->max_delta_t, &ch);
         double natural = ch.dt;
         *limiter = ch.limiter;

@@ -147,7 +147,12 @@ static void draw_map(const char *case_dir, const char *sweep, const mf_value *sc
         {"stable", xs[0], ys[0], count[0], "points pt 7 ps 2.5 lc rgb '#2a9d2a'", NULL},
         {"unstable", xs[1], ys[1], count[1], "points pt 5 ps 2.5 lc rgb '#d62728'", labels[1]},
     };
-    if (mf_report_plot(path, &plot, series, 2) != 0) {
+    /* Only the classes present: gnuplot warns about an empty data block. */
+    size_t ns = 0;
+    for (int k = 0; k < 2; k++)
+        if (series[k].n > 0)
+            series[ns++] = series[k];
+    if (mf_report_plot(path, &plot, series, ns) != 0) {
         fprintf(stderr, "%s\n", mf_error_message());
         mf_error_clear();
     }

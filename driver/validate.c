@@ -11,6 +11,7 @@
 
 extern const mf_metric mf_metric_scalar_advection; /* metric_scalar.c */
 extern const mf_metric mf_metric_volume_flux;      /* metric_scalar.c */
+extern const mf_metric mf_metric_poiseuille;       /* metric_poiseuille.c */
 
 /* metric_droplet.c: the multi-fluid cases */
 extern const mf_metric mf_metric_laplace, mf_metric_oscillation, mf_metric_layering,
@@ -26,6 +27,7 @@ static const mf_metric *const metrics[] = {
     &mf_metric_layering,
     &mf_metric_rayleigh_taylor,
     &mf_metric_fluid_surge_front,
+    &mf_metric_poiseuille,
 };
 #define NMETRICS (sizeof metrics / sizeof metrics[0])
 
@@ -110,7 +112,7 @@ int mf_cmd_validate(const char *case_dir, double *error)
         const char *hint = mf_did_you_mean(name, names, NMETRICS);
         rc = MF_ERROR(MF_ERR_INPUT, "%s: unknown metric '%s'%s%s%s; known: surgeFront, "
                       "hydrostaticPressure, scalarAdvection, volumeFlux, laplacePressure, "
-                      "oscillationPeriod, layering, rayleighTaylor, fluidSurgeFront",
+                      "oscillationPeriod, layering, rayleighTaylor, fluidSurgeFront, poiseuille",
                       path, name, hint ? " (did you mean '" : "", hint ? hint : "",
                       hint ? "'?)" : "");
     }

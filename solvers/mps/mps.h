@@ -37,6 +37,10 @@ typedef struct mps_settings {
     bool collision_after_correction; /* a second collision pass after eqs. 15-17 */
     double restitution;
     long reorder_interval;    /* sort particles along cells every N steps (0: never) */
+    const char *viscosity;    /* "explicit" (eq. 7 term in the explicit phase) or "implicit" */
+    double viscosity_tolerance; /* relative residual of the implicit viscous solves */
+    double periodic_length;   /* period along x, m (0: no periodic axis) */
+    double periodic_origin;   /* x of the periodic box's lower face, m */
 } mps_settings;
 
 /* Pair averages (eq. 27 with unlike neighbours; the variable-density PPE).
@@ -108,13 +112,20 @@ typedef struct mps_data {
      * NULL: nothing. */
     int (*before_assembly)(struct mps_data *d, mf_sim *sim, void *ctx);
     void *before_assembly_ctx;
+    /* Implicit viscosity (mps_viscosity.c); NULL with `viscosity explicit`. */
+    struct mps_viscosity *visc;
+    /* Periodic images along x (mps_periodic.c); NULL without a period. While a
+     * step runs, particles [n_owned, n) are images of image_owner[k - n_owned]. */
+    struct mps_periodic *periodic;
+    const size_t *image_owner;
 } mps_data;
 
 enum { MPS_FLAG_SURFACE = 1 }; /* bits of the Flags field */
 
 extern const mf_solver_ops mf_solver_MPS;
-#define MPS_NPARAMS 13 /* checked against the table in mps_params.c */
+#define MPS_NPARAMS 17 /* checked against the table in mps_params.c */
 extern const mf_param mps_params[MPS_NPARAMS];
+extern const char *const mps_viscosity_choices[]; /* explicit, implicit */
 /* The entries of that table, for a solver whose settings embed an
  * mps_settings (the multi-fluid solver): OFF(field) is the offset of the
  * embedded field in the embedding struct. One list, two tables.
@@ -153,6 +164,15 @@ extern const mf_param mps_params[MPS_NPARAMS];
     {"reorderInterval", MF_PARAM_INT, "25", 0, 1000000, NULL,                                   \
      OFF(reorder_interval),                                                                     \
      "sort particles along cells every N steps for memory locality (0: never)"},                \
+    {"viscosity", MF_PARAM_WORD, "explicit", MF_NO_RANGE, mps_viscosity_choices,                 \
+     OFF(viscosity),                                                                            \
+     "explicit (eq. 7 in the explicit phase, dt limited by maxDi) or implicit (hypre solve)"},   \
+    {"viscosityTolerance", MF_PARAM_SCALAR, "1e-10", 1e-16, 1e-2, NULL,                         \
+     OFF(viscosity_tolerance), "relative residual of the implicit viscous solves"},              \
+    {"periodicLength", MF_PARAM_SCALAR, "0", 0, 1e9, NULL, OFF(periodic_length),                 \
+     "period along x, m (0: none); the walls must be open at xmin and xmax"},                    \
+    {"periodicOrigin", MF_PARAM_SCALAR, "0", -1e9, 1e9, NULL, OFF(periodic_origin),             \
+     "x of the periodic box's lower face, m"},                                                   \
 
 
 /* mps_module.c */
@@ -192,5 +212,36 @@ void mps_gradient_pairs(mps_data *d, const mf_particles *p, const double *pressu
 /* eqs. 16-17 for those particles: u' = -dt grad, u += u', r += dt u'.
  * Returns max |u'|. */
 double mps_apply_correction(mps_data *d, mf_particles *p, double dt, const uint8_t *imask);
+
+/* mps_viscosity.c: implicit viscosity. Solve, per velocity component,
+ *   (I - dt nu <lap>) u* = u^n + dt a_forces
+ * with the eq. 7 Laplacian (per particle rho and pair mu_ij with
+ * mps_data.mu: rows scaled by rho_i, so the matrix stays symmetric), walls and
+ * dummies as Dirichlet values (their velocity), free-surface particles in the
+ * system with their missing neighbours absent. */
+int mps_viscosity_create(mps_data *d, mf_sim *sim);
+void mps_viscosity_destroy(struct mps_viscosity *v);
+/* Replaces the explicit update of mps_explicit_phase: d->acc holds the force
+ * accelerations; on return u = u*, r = r^n + dt u*. */
+int mps_viscosity_implicit(mps_data *d, mf_sim *sim, double dt);
+void mps_viscosity_report(const struct mps_viscosity *v, const mf_sim *sim, mf_log *log);
+
+/* mps_periodic.c: a periodic x axis by image particles. Before each grid
+ * build, fluid is wrapped into [x0, x0 + L) and particles within the largest
+ * radius of a periodic face get an image shifted by -+L (appended after
+ * n_owned); operators read the images like any neighbour and the PPE maps
+ * an image to its owner's row. mps_periodic_end removes the images. */
+int mps_periodic_create(mps_data *d, mf_sim *sim, double rmax);
+void mps_periodic_destroy(struct mps_periodic *pp);
+int mps_periodic_begin(mps_data *d, mf_sim *sim); /* wrap, remove old images */
+int mps_periodic_add_images(mps_data *d, mf_sim *sim);
+void mps_periodic_end(mps_data *d, mf_sim *sim);  /* wrap, remove images */
+/* Copy per-particle values of owners to their images (n values of size bytes each). */
+void mps_periodic_sync(const mps_data *d, const mf_particles *p, void *values, size_t size);
+/* Owner of particle j (j itself when it is not an image). */
+static inline size_t mps_owner(const mps_data *d, const mf_particles *p, size_t j)
+{
+    return j < p->n_owned || !d->image_owner ? j : d->image_owner[j - p->n_owned];
+}
 
 #endif

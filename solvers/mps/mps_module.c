@@ -41,6 +41,8 @@ int mps_reserve(mps_data *d, size_t n)
 int mps_create_data(const mps_settings *s, mf_sim *sim, const mf_dict *solver_dict,
                     mps_data **out)
 {
+    if (s->periodic_length > 0)
+        return MF_ERROR(MF_ERR_INPUT, "periodicLength: only solver MPS has a periodic axis");
     mps_data *d = calloc(1, sizeof *d);
     if (!d)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory");
@@ -62,6 +64,8 @@ int mps_create_data(const mps_settings *s, mf_sim *sim, const mf_dict *solver_di
                                        &d->f_number_density));
     MF_CALL(mf_particles_request_field(sim->p, "Flags", 1, MF_FIELD_INT32, true, &d->f_flags));
     MF_CALL(create_pressure(d, sim, solver_dict));
+    if (strcmp(s->viscosity, "implicit") == 0)
+        MF_CALL(mps_viscosity_create(d, sim));
     MF_CALL(mps_reserve(d, sim->p->n));
     const mf_kernel *ks[3] = {&d->k_nd, &d->k_grad, &d->k_lap};
     const char *names[3] = {"number density", "gradient", "Laplacian"};
@@ -80,6 +84,8 @@ void mps_destroy_data(mps_data *d)
     if (d->pressure_ops && d->pressure.data)
         d->pressure_ops->destroy(d->pressure.data);
     mf_module_release(&d->pressure);
+    mps_viscosity_destroy(d->visc);
+    mps_periodic_destroy(d->periodic);
     mf_grid_free(&d->grid);
     mf_nlist_free(&d->nl_max);
     mf_nlist_free(&d->nl_nd);
@@ -108,8 +114,20 @@ static int mps_create(const void *settings, mf_sim *sim, const mf_dict *solver_d
                         "use solver multiFluid",
                         sim->nfluids, sim->fluid[0].name, sim->fluid[1].name,
                         sim->nfluids > 2 ? ", ..." : "");
+    /* Only this solver has a periodic axis (mps_periodic.c): the composing
+     * solvers call the phases themselves. */
+    mps_settings s = *(const mps_settings *)settings;
+    const double period = s.periodic_length;
+    s.periodic_length = 0;
     mps_data *d = NULL;
-    int rc = mps_create_data(settings, sim, solver_dict, &d);
+    int rc = mps_create_data(&s, sim, solver_dict, &d);
+    if (rc == 0 && period > 0) {
+        d->s.periodic_length = period;
+        double rmax = d->k_nd.re;
+        if (d->k_grad.re > rmax) rmax = d->k_grad.re;
+        if (d->k_lap.re > rmax) rmax = d->k_lap.re;
+        rc = mps_periodic_create(d, sim, rmax);
+    }
     if (rc != 0) {
         mps_destroy_data(d);
         return mf_error_trace(rc, __FILE__, __LINE__, __func__);
@@ -152,6 +170,7 @@ static void mps_report(void *data, const mf_sim *sim, mf_log *log)
                   "MPS pressure: %ld unknowns in the last solve, %.2f iterations per solve on "
                   "average\n",
                   d->ppe_rows, sim->pressure_iterations / steps);
+    mps_viscosity_report(d->visc, sim, log);
 }
 
 const mf_solver_ops mf_solver_MPS = {

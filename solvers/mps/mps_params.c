@@ -7,3 +7,5 @@
 const mf_param mps_params[MPS_NPARAMS] = {MPS_PARAM_ENTRIES(MPS_OFFSET)};
 /* Too many entries fail to compile; too few leave a nameless entry, which
  * the registry refuses at start-up. */
+
+const char *const mps_viscosity_choices[] = {"explicit", "implicit", NULL};

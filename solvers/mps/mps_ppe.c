@@ -104,6 +104,8 @@ int mps_assemble_ppe(mps_data *d, const mf_sim *sim, double dt)
                 nnz += d->in_ppe[nl->j[k]];
         }
     }
+    if (d->periodic) /* an image is its owner's unknown */
+        mps_periodic_sync(d, p, d->row, sizeof *d->row);
     MF_CALL(reserve_system(d, nrows, nnz));
     uint8_t *touches = calloc(nrows ? nrows : 1, 1);
     if (!touches)
@@ -194,6 +196,49 @@ int mps_assemble_ppe(mps_data *d, const mf_sim *sim, double dt)
     return 0;
 }
 
+/* The pressure solve did not converge (MF_RETRY from the pressure module):
+ * name it as the run's watch names its criteria (pressureSolve), with the
+ * time, the residuals and the particle of the largest residual, so that a
+ * run stopped by it says where. Stays MF_RETRY: a smaller step may fix it. */
+static int solve_failed(const mps_data *d, const mf_sim *sim)
+{
+    const mf_particles *p = sim->p;
+    const mf_csr *A = &d->A;
+    size_t worst = 0;
+    double rmax = -1;
+    for (size_t r = 0; r < A->nrows; r++) {
+        double res = d->rhs[r];
+        for (size_t k = A->rowptr[r]; k < A->rowptr[r + 1]; k++)
+            res -= A->val[k] * d->x[A->col[k] - A->row_offset];
+        if (!(fabs(res) <= rmax)) {
+            rmax = fabs(res);
+            worst = r;
+        }
+    }
+    size_t i = 0;
+    while (i < p->n_owned && d->row[i] != (long)worst)
+        i++;
+    const char *why = d->last.final_residual > d->last.initial_residual ||
+                              !isfinite(d->last.final_residual)
+                          ? ", diverging"
+                          : "";
+    if (i == p->n_owned)
+        return MF_ERROR(MF_RETRY,
+                        "unstable (pressureSolve) at time %g, step %ld: %s not converged after "
+                        "%d iterations (relative residual %g, from %g%s)",
+                        sim->time + sim->dt, sim->step + 1, d->pressure.info->name,
+                        d->last.iterations, d->last.final_residual, d->last.initial_residual,
+                        why);
+    const double *x = &p->pos[3 * i];
+    return MF_ERROR(MF_RETRY,
+                    "unstable (pressureSolve) at time %g, step %ld: %s not converged after %d "
+                    "iterations (relative residual %g, from %g%s); largest residual at %s "
+                    "particle id %lld at (%g %g %g)",
+                    sim->time + sim->dt, sim->step + 1, d->pressure.info->name,
+                    d->last.iterations, d->last.final_residual, d->last.initial_residual, why,
+                    mf_particle_kind_name(p->kind[i]), (long long)p->id[i], x[0], x[1], x[2]);
+}
+
 int mps_solve_ppe(mps_data *d, mf_sim *sim)
 {
     double t0 = mf_wall_seconds();
@@ -209,6 +254,8 @@ int mps_solve_ppe(mps_data *d, mf_sim *sim)
     d->t_setup += d->last.setup_seconds;
     d->t_pcg += d->last.solve_seconds;
     d->t_solve += mf_wall_seconds() - t0;
+    if (rc == MF_RETRY)
+        return solve_failed(d, sim);
     if (rc != 0)
         return mf_error_trace(rc, __FILE__, __LINE__, __func__);
     double *pressure = mf_particles_fd(p, d->f_pressure);
@@ -216,5 +263,7 @@ int mps_solve_ppe(mps_data *d, mf_sim *sim)
         double v = d->row[i] >= 0 ? d->x[d->row[i]] : (d->p_dirichlet ? d->p_dirichlet[i] : 0.0);
         pressure[i] = (d->s.clip_negative_pressure && v < 0) ? 0.0 : v;
     }
+    if (d->periodic)
+        mps_periodic_sync(d, p, pressure, sizeof *pressure);
     return 0;
 }

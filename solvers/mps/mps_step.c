@@ -38,6 +38,8 @@ int mps_build_neighbours(mps_data *d, mf_sim *sim, bool reorder)
     double t0 = mf_wall_seconds();
     mf_particles *p = sim->p;
     const double rmax = max_radius(d);
+    if (d->periodic)
+        MF_CALL(mps_periodic_begin(d, sim)); /* wrap, drop the last images */
     MF_CALL(mf_grid_build(&d->grid, p, rmax));
     if (reorder && d->s.reorder_interval > 0 && sim->step % d->s.reorder_interval == 0) {
         /* Sort along cells: neighbours become neighbours in memory too. */
@@ -49,6 +51,10 @@ int mps_build_neighbours(mps_data *d, mf_sim *sim, bool reorder)
             rc = mf_particles_permute(p, perm);
         free(perm);
         MF_CALL(rc);
+        MF_CALL(mf_grid_build(&d->grid, p, rmax));
+    }
+    if (d->periodic) { /* images across the periodic faces, then the grid again */
+        MF_CALL(mps_periodic_add_images(d, sim));
         MF_CALL(mf_grid_build(&d->grid, p, rmax));
     }
     MF_CALL(mf_nlist_build(&d->nl_max, &d->grid, p, rmax));
@@ -128,7 +134,9 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
         }
     }
     sim->neighbours = NULL;
-    if (d->mu) {
+    if (d->visc) { /* viscosity implicit: u* = (I - dt nu lap)^-1 (u + dt a), r* = r + dt u* */
+        MF_CALL(mps_viscosity_implicit(d, sim, dt));
+    } else if (d->mu) {
         mps_viscous_pairs(d, p, list_for(d, &d->nl_lap, d->k_lap.re), d->acc);
     } else if (nu > 0) {
         const mf_nlist *nl = list_for(d, &d->nl_lap, d->k_lap.re);
@@ -138,7 +146,7 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
                 for (int c = 0; c < 3; c++)
                     d->acc[3 * i + c] += nu * d->grad[3 * i + c];
     }
-    for (size_t i = 0; i < p->n_owned; i++) {
+    for (size_t i = 0; i < p->n_owned && !d->visc; i++) {
         if (!d->is_fluid[i])
             continue;
         for (int c = 0; c < 3; c++) {
@@ -146,6 +154,8 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
             p->pos[3 * i + c] += dt * p->vel[3 * i + c];
         }
     }
+    if (d->periodic) /* images move with their owners */
+        mps_periodic_sync(d, p, p->vel, 3 * sizeof(double));
     if (d->s.collision)
         collide(d, sim, dt);
     d->t_explicit += mf_wall_seconds() - t0;
@@ -168,6 +178,10 @@ int mps_surface_phase(mps_data *d, mf_sim *sim)
         flags[i] = surface ? MPS_FLAG_SURFACE : 0;
         if (!d->not_dummy[i])
             n[i] = 0; /* dummies take part only as neighbours */
+    }
+    if (d->periodic) { /* an image is what its owner is */
+        mps_periodic_sync(d, p, d->dirichlet, 1);
+        mps_periodic_sync(d, p, d->in_ppe, 1);
     }
     d->t_assembly += mf_wall_seconds() - t0;
     return 0;
@@ -231,5 +245,7 @@ int mps_lagrangian_step(mps_data *d, mf_sim *sim, double dt)
     MF_CALL(mps_build_neighbours(d, sim, false)); /* at r*, for the pressure */
     MF_CALL(mps_pressure_phase(d, sim, dt));
     MF_CALL(mps_correction_phase(d, sim, dt));
+    if (d->periodic)
+        mps_periodic_end(d, sim); /* wrap, remove the images */
     return 0;
 }

@@ -1,0 +1,57 @@
+#!/bin/sh
+# A small `mpsflow compare` on hydrostatic2D and scalarAdvection: two schemes
+# at two particle spacings each. The CSV and the PNG are written, every run
+# completes, and each scheme's error falls from the coarse to the fine
+# spacing. argv: mpsflow, tutorials/ (the source tree's), folder of the plugins.
+mpsflow=$1; tutorials=$2; export MPSFLOW_PLUGIN_PATH=$3
+export OMP_NUM_THREADS=1
+dir=$(mktemp -d)
+trap 'rm -rf "$dir"' EXIT
+passed=0; failed=0
+fail() { echo "FAIL $*"; failed=$((failed + 1)); }
+ok() { echo "ok   $*"; passed=$((passed + 1)); }
+
+# compare_case NAME SCHEMES: run the compare on $dir/NAME and check its output.
+compare_case() {
+    name=$1; schemes=$2
+    "$mpsflow" compare -case "$dir/$name" -solvers "$schemes" -resolutions '(0.02 0.01)' \
+        > "$dir/$name.log" 2>&1 || { fail "$name: compare exited with $?"; tail -5 "$dir/$name.log"; return; }
+    csv=$dir/$name/compare/compare.csv png=$dir/$name/compare/compare.png
+    [ -s "$csv" ] || { fail "$name: no compare.csv"; return; }
+    # A PNG starts with \211PNG.
+    [ "$(head -c 4 "$png" 2>/dev/null | tail -c 3)" = "PNG" ] || { fail "$name: compare.png is not a PNG"; return; }
+    rows=$(grep -vc -e '^#' -e '^scheme,' "$csv")
+    [ "$rows" -eq 4 ] || { fail "$name: $rows rows in compare.csv, expected 4"; cat "$csv"; return; }
+    # Per scheme: completed at both spacings, error(0.01) < error(0.02).
+    verdict=$(awk -F, '!/^#/ && !/^scheme,/ {
+            if ($9 != "completed") bad = bad " " $1 "@" $2 ":" $9;
+            err[$1 "," $2] = $4; seen[$1] = 1 }
+        END { for (s in seen) {
+                c = err[s ",0.02"]; f = err[s ",0.01"];
+                printf "%s %s -> %s; ", s, c, f;
+                if (!(f + 0 < c + 0) || c == "" || f == "" || c == "nan" || f == "nan") bad = bad " " s ":not-falling" }
+              if (bad != "") printf "BAD%s", bad }' "$csv")
+    case "$verdict" in
+        *BAD*) fail "$name: $verdict"; cat "$csv" ;;
+        *) ok "$name: error falls with resolution: $verdict" ;;
+    esac
+}
+
+# hydrostatic2D, shortened: 1 s, averaged after 0.5 s.
+cp -r "$tutorials/hydrostatic2D" "$dir/hydrostatic2D"
+rm -rf "$dir/hydrostatic2D/output" "$dir/hydrostatic2D/compare" "$dir/hydrostatic2D/postProcessing"
+sed -i 's/^endTime .*/endTime 1.0;/' "$dir/hydrostatic2D/system/controlDict"
+sed -i 's/^settleTime .*/settleTime 0.5;/' "$dir/hydrostatic2D/validation/metric"
+compare_case hydrostatic2D '(MPS MPS_diagonalPCG)'
+
+# scalarAdvection: QUICK + filter (the case as it is) against upwind.
+cp -r "$tutorials/scalarAdvection" "$dir/scalarAdvection"
+rm -rf "$dir/scalarAdvection/output" "$dir/scalarAdvection/compare"
+cat > "$dir/scalarAdvection/system/compareDict" <<'DICT'
+FoamFile { version 2.0; format ascii; class dictionary; object compareDict; }
+variants { MAFL_upwind { MAFLCoeffs { convection { scheme upwind; } } } }
+DICT
+compare_case scalarAdvection '(MAFL MAFL_upwind)'
+
+echo "$passed passed, $failed failed"
+[ $failed -eq 0 ]
