@@ -87,6 +87,9 @@ typedef struct mps_data {
     mf_solve_report last;
     long ppe_rows;
     double t_neighbours, t_explicit, t_assembly, t_solve, t_correction;
+    long solves;               /* pressure solves run here (sim->pressure_iterations' count) */
+    long attempts;             /* explicit phases run here, retried ones included: the
+                                * timers' denominator (sim->step counts from before a restart) */
     double t_setup, t_pcg; /* parts of t_solve, as the pressure module reports them */
     /* Multi-fluid, set by a composing solver after mps_create_data (all NULL
      * for one fluid: the single-fluid path, unchanged). Arrays have one entry

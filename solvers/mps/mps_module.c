@@ -155,21 +155,22 @@ static int mps_stable_dt(void *data, const mf_sim *sim, double *dt)
 static void mps_report(void *data, const mf_sim *sim, mf_log *log)
 {
     const mps_data *d = data;
-    const double steps = sim->step > 0 ? (double)sim->step : 1.0;
+    const double attempts = d->attempts > 0 ? (double)d->attempts : 1.0;
     const double total = d->t_neighbours + d->t_explicit + d->t_assembly + d->t_solve +
                          d->t_correction;
     mf_log_printf(log, MF_LOG_QUIET,
                   "MPS time per step (ms): neighbour search %.3f, explicit %.3f, number density "
                   "+ assembly %.3f, pressure solve %.3f (AMG setup %.3f, PCG %.3f), correction "
                   "%.3f; total %.3f\n",
-                  1e3 * d->t_neighbours / steps, 1e3 * d->t_explicit / steps,
-                  1e3 * d->t_assembly / steps, 1e3 * d->t_solve / steps,
-                  1e3 * d->t_setup / steps, 1e3 * d->t_pcg / steps,
-                  1e3 * d->t_correction / steps, 1e3 * total / steps);
+                  1e3 * d->t_neighbours / attempts, 1e3 * d->t_explicit / attempts,
+                  1e3 * d->t_assembly / attempts, 1e3 * d->t_solve / attempts,
+                  1e3 * d->t_setup / attempts, 1e3 * d->t_pcg / attempts,
+                  1e3 * d->t_correction / attempts, 1e3 * total / attempts);
     mf_log_printf(log, MF_LOG_QUIET,
                   "MPS pressure: %ld unknowns in the last solve, %.2f iterations per solve on "
                   "average\n",
-                  d->ppe_rows, sim->pressure_iterations / steps);
+                  d->ppe_rows,
+                  (double)sim->pressure_iterations / (d->solves > 0 ? (double)d->solves : 1.0));
     mps_viscosity_report(d->visc, sim, log);
 }
 

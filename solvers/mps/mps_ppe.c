@@ -251,6 +251,7 @@ int mps_solve_ppe(mps_data *d, mf_sim *sim)
                   d->last.initial_residual, d->last.final_residual,
                   d->last.iterations);
     sim->pressure_iterations += d->last.iterations;
+    d->solves++;
     d->t_setup += d->last.setup_seconds;
     d->t_pcg += d->last.solve_seconds;
     d->t_solve += mf_wall_seconds() - t0;

@@ -121,6 +121,7 @@ static void collide(mps_data *d, mf_sim *sim, double dt)
 int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
 {
     double t0 = mf_wall_seconds();
+    d->attempts++;
     mf_particles *p = sim->p;
     const double nu = sim->fluid[0].nu;
     memset(d->acc, 0, 3 * p->n * sizeof *d->acc);
