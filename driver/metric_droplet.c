@@ -714,6 +714,7 @@ static const mf_param front_params[] = {
      "x of the far wall, m: reference points beyond it (the front stops there) are left out"},
 };
 
+/* The front of one fluid (metric_surge_front.c's rule). */
 static int fluid_front(const snap *sn, int fluid, double back_wall, double *z)
 {
     const mf_particles *all = sn->sim.p;
@@ -723,22 +724,8 @@ static int fluid_front(const snap *sn, int fluid, double back_wall, double *z)
     for (size_t i = 0; i < all->n && rc == 0; i++)
         if (is_of(sn, i, fluid))
             rc = mf_particles_add(f, MF_FLUID, &all->pos[3 * i], &all->vel[3 * i], NULL);
-    mf_grid g;
-    mf_nlist nl;
-    mf_grid_init(&g);
-    mf_nlist_init(&nl);
-    const double radius = 2.1 * sn->h.l0;
-    *z = 0;
-    if (rc == 0 && f->n > 0) {
-        rc = mf_grid_build(&g, f, radius);
-        if (rc == 0)
-            rc = mf_nlist_build(&nl, &g, f, radius);
-        for (size_t i = 0; rc == 0 && i < f->n; i++)
-            if (nl.start[i + 1] - nl.start[i] >= 2 && f->pos[3 * i] - back_wall > *z)
-                *z = f->pos[3 * i] - back_wall;
-    }
-    mf_grid_free(&g);
-    mf_nlist_free(&nl);
+    if (rc == 0)
+        rc = mf_front_of_particles(f, sn->h.l0, back_wall, z);
     mf_particles_destroy(f);
     return rc;
 }

@@ -35,6 +35,28 @@ static const mf_param front_params[] = {
 };
 static const char *const front_extra[] = {"FoamFile", NULL};
 
+int mf_front_of_particles(const mf_particles *fluid, double l0, double back_wall, double *z)
+{
+    mf_grid g;
+    mf_nlist nl;
+    mf_grid_init(&g);
+    mf_nlist_init(&nl);
+    const double radius = 2.1 * l0;
+    int rc = 0;
+    *z = 0;
+    if (fluid->n > 0) {
+        rc = mf_grid_build(&g, fluid, radius);
+        if (rc == 0)
+            rc = mf_nlist_build(&nl, &g, fluid, radius);
+        for (size_t i = 0; rc == 0 && i < fluid->n; i++)
+            if (nl.start[i + 1] - nl.start[i] >= 2 && fluid->pos[3 * i] - back_wall > *z)
+                *z = fluid->pos[3 * i] - back_wall;
+    }
+    mf_grid_free(&g);
+    mf_nlist_free(&nl);
+    return rc;
+}
+
 /* Front of one snapshot, in m from the back wall. */
 static int front_of(const mf_sim *snap, double back_wall, double *z)
 {
@@ -45,22 +67,8 @@ static int front_of(const mf_sim *snap, double back_wall, double *z)
     for (size_t i = 0; i < all->n && rc == 0; i++)
         if (all->kind[i] == MF_FLUID)
             rc = mf_particles_add(fluid, MF_FLUID, &all->pos[3 * i], &all->vel[3 * i], NULL);
-    mf_grid g;
-    mf_nlist nl;
-    mf_grid_init(&g);
-    mf_nlist_init(&nl);
-    const double radius = 2.1 * snap->l0;
-    *z = 0;
-    if (rc == 0 && fluid->n > 0) {
-        rc = mf_grid_build(&g, fluid, radius);
-        if (rc == 0)
-            rc = mf_nlist_build(&nl, &g, fluid, radius);
-        for (size_t i = 0; rc == 0 && i < fluid->n; i++)
-            if (nl.start[i + 1] - nl.start[i] >= 2 && fluid->pos[3 * i] - back_wall > *z)
-                *z = fluid->pos[3 * i] - back_wall;
-    }
-    mf_grid_free(&g);
-    mf_nlist_free(&nl);
+    if (rc == 0)
+        rc = mf_front_of_particles(fluid, snap->l0, back_wall, z);
     mf_particles_destroy(fluid);
     return rc;
 }

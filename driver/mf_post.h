@@ -20,6 +20,11 @@ typedef struct mf_metric {
 } mf_metric;
 
 extern const mf_metric mf_metric_surge_front;
+
+/* The surge front of a fluid particle set: the largest x - back_wall of a
+ * particle with at least two neighbours within 2.1 l0 (lone splashes do not
+ * count); 0 for no particle. */
+int mf_front_of_particles(const mf_particles *fluid, double l0, double back_wall, double *z);
 extern const mf_metric mf_metric_hydrostatic;
 
 /* `mpsflow validate -case DIR`: prints "error <metric> = <value>". */
