@@ -29,7 +29,7 @@
 #include <string.h>
 #include <sys/resource.h>
 
-#include "levelset/levelset.h"
+#include "surface/levelset/levelset.h"
 #include "mf_dictio.h"
 #include "mf_hdf5.h"
 #include "mf_run.h"

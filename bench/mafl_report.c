@@ -5,7 +5,7 @@
  * Gaussian against the exact, shifted profile) and writes
  *   OUT/mafl_scalar_advection.csv   scheme, l0, error, wall seconds, order
  *   OUT/mafl_scalar_advection.png   error against run time, one line per scheme
- * through io/mf_report.h.
+ * through io/report/mf_report.h.
  *
  *   build/bench/mafl_report MPSFLOW TUTORIAL_DIR OUT_DIR [l0 ...]
  *   (bench/mafl_report.sh runs it with the defaults: l0 = 0.02 0.01 0.005)

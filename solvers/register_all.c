@@ -3,11 +3,11 @@
 #include "mf_solvers.h"
 
 #include "convection/convection.h"
-#include "forces/forces.h"
-#include "levelset/levelset.h"
-#include "mafl/mafl.h"
-#include "mps/mps.h"
-#include "multifluid/multifluid.h"
+#include "force/forces.h"
+#include "surface/levelset/levelset.h"
+#include "solver/mafl/mafl.h"
+#include "solver/mps/mps.h"
+#include "solver/multifluid/multifluid.h"
 #include "pressure/pressure_hypre.h"
 
 int mf_solvers_register_all(mf_registry *reg)
@@ -19,7 +19,6 @@ int mf_solvers_register_all(mf_registry *reg)
         &mf_force_gravity.info,
         &mf_surface_levelSet.info,
         &mf_surface_blobby.info,
-        &mf_function_surface.info,
         &mf_solver_multiFluid.info,
         &mf_force_surfaceTension.info,
         &mf_force_drag.info,

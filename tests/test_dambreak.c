@@ -3,7 +3,7 @@
  *
  * The tutorial is copied to a temporary folder and run to t = 0.35 s
  * (T = t sqrt(2 g / a) = 3.1) with snapshots every 0.01 s. The surge front
- * is computed as driver/metric_surge_front.c computes it: the largest x
+ * is computed as driver/post/metric_surge_front.c computes it: the largest x
  * (from the back wall) of a fluid particle with at least two fluid
  * neighbours within 2.1 l0; Z = x / a, linear in time between snapshots.
  * At T = 1.5 and 2.5, |Z - Z_ref| <= 0.3, Z_ref interpolated linearly in

@@ -1,5 +1,5 @@
-/* test_dict.c: the dictionary tree (core/dict.c) and the OpenFOAM-syntax
- * parser (io/dict_parse.c).
+/* test_dict.c: the dictionary tree (core/host/dict.c) and the OpenFOAM-syntax
+ * parser (io/dict/dict_parse.c).
  *
  * Usage: test_dict CORPUS_DIR, where CORPUS_DIR holds the malformed inputs
  * bad_*.dict (meson passes tests/dict_corpus). Inputs that must not be

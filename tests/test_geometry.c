@@ -1,5 +1,5 @@
-/* test_geometry.c: polygon files into particles (core/mf_trimesh.h,
- * io/mf_mesh_import.h).
+/* test_geometry.c: polygon files into particles (core/scene/mf_trimesh.h,
+ * io/mesh/mf_mesh_import.h).
  *
  * - mesh checks on meshes built here: a cube is closed with volume 1;
  *   degenerate triangles go; a turned face is turned back; an open box has

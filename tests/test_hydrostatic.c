@@ -58,7 +58,7 @@ static const char *const metric =
 typedef struct stats {
     /* Interior fluid particles, per bin of height l0, summed over settled snapshots. */
     double psum[NBINS], ysum[NBINS], nsum[NBINS], count[NBINS];
-    /* The same binned as driver/metric_hydrostatic.c bins them (y in [0, H), h.time >= settle). */
+    /* The same binned as driver/post/metric_hydrostatic.c bins them (y in [0, H), h.time >= settle). */
     double mpsum[NBINS], mcount[NBINS];
     double surf_ysum, surf_count;     /* surface-flagged fluid particles in the top region */
     double top_ysum, top_count;       /* the highest fluid particle of each column of width l0 */
@@ -176,7 +176,7 @@ static void fit_line(const stats *s, double y0, double y1, double *a, double *b)
     *a = (sp - *b * sy) / n;
 }
 
-/* The RMS of driver/metric_hydrostatic.c, recomputed from the snapshots. */
+/* The RMS of driver/post/metric_hydrostatic.c, recomputed from the snapshots. */
 static double metric_rms(const stats *s)
 {
     double sum = 0;

@@ -22,7 +22,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "levelset/levelset.h"
+#include "surface/levelset/levelset.h"
 #include "mf_dictio.h"
 #include "mf_test.h"
 

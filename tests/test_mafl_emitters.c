@@ -1,5 +1,5 @@
 /* test_mafl_emitters.c: inlets, outlets, nozzles and transported scalars
- * (core/mf_emitter.h) on scenes built from geometry text, with the solver
+ * (core/scene/mf_emitter.h) on scenes built from geometry text, with the solver
  * replaced by "fluid moves with its velocity" (what a uniform flow does).
  *
  *   - scalar profiles: values, declared fields, reserved names refused;

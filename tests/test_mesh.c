@@ -15,7 +15,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "levelset/levelset.h"
+#include "surface/levelset/levelset.h"
 #include "mf_mesh_writer.h"
 #include "mf_test.h"
 

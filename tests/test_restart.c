@@ -271,7 +271,7 @@ static void run_pair(const char *exe, const char *label, const char *control,
         CHECK_MSG(same, "%s: the restarted run is not bit-identical to the straight one", label);
         if (!same) {
             double next = explain(&whole, &split, label);
-            /* The adjustable step grows from the last natural step (core/run.c,
+            /* The adjustable step grows from the last natural step (core/run/run.c,
              * natural_dt), which a snapshot does not hold: a restart grows from deltaT
              * again. Seed deltaT with the straight run's step after the split and see
              * whether that was all. */

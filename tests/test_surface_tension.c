@@ -21,7 +21,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "forces/forces.h"
+#include "force/forces.h"
 #include "mf_dictio.h"
 #include "mf_modules.h"
 #include "mf_solvers.h"

@@ -1,7 +1,7 @@
 /* test_surface_tension_drop.c: surface tension in motion, the droplet
  * tutorials at l0 = 1.5 mm (the tutorials' 1 mm costs 2-3 times more)
  * through the mpsflow executable and `mpsflow validate`
- * (driver/metric_droplet.c). Both tutorials use surfaceTension
+ * (driver/post/metric_droplet.c). Both tutorials use surfaceTension
  * `freeSurface pressure`: the free-surface particles hold the Laplace
  * pressure sigma kappa (README, "Multi-fluid").
  *

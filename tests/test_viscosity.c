@@ -1,5 +1,5 @@
-/* test_viscosity.c: implicit viscosity (solvers/mps/mps_viscosity.c) and the
- * periodic x axis (solvers/mps/mps_periodic.c), through the mpsflow
+/* test_viscosity.c: implicit viscosity (solvers/solver/mps/mps_viscosity.c) and the
+ * periodic x axis (solvers/solver/mps/mps_periodic.c), through the mpsflow
  * executable on the start-up of plane Poiseuille flow (a viscous liquid,
  * nu = 1e-3 m^2/s, between plates 0.1 m apart, periodic channel 0.08 m long,
  * l0 = 0.01 m, body force 0.008 m/s^2; tutorials/poiseuille2D).

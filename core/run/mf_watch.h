@@ -1,0 +1,67 @@
+/* mf_watch.h: watching a run for the signs of instability.
+ *
+ * After every step the watch checks, in this order:
+ *   nonFinite     NaN or Inf in a position, a velocity or any field;
+ *   throughWall   a fluid particle past the wall-particle line of a closed
+ *                 face of a wall box (fluid centres stay about l0/2 inside);
+ *   densityCollapse  the mean number density of the fluid below a fraction
+ *                 of n0, or of its value at the start when that is lower (a
+ *                 thin sheet, a spray, a single particle start below n0: the
+ *                 fluid has blown apart when it thins from where it was);
+ *   energy        kinetic energy growing without a source: KE - KE0 - W,
+ *                 W the work of the force modules (gravity, surface tension,
+ *                 ...) integrated over the run, above a fraction of the
+ *                 run's energy scale KE0 + |W| + sum m |a_ext| L + sigma S
+ *                 (S: the surface of the fluid's bounding box at the start;
+ *                 surface tension applied as a pressure condition does work
+ *                 no force module reports).
+ * A pressure solve that diverges or does not converge is reported by the
+ * solver itself, in the same form: `unstable (pressureSolve) at time ...`
+ * with the particle of the largest residual (solvers/solver/mps/mps_ppe.c); a step
+ * that the limits shrink below minDeltaT is `unstable (timeStep)` (core/run/run.c).
+ * A check
+ * that fires fails the step with MF_ERR_NUMERIC and a message that names
+ * the criterion, the time and the particle (the time loop retries with a
+ * smaller step, then stops and keeps the last good state).
+ */
+#ifndef MF_WATCH_H
+#define MF_WATCH_H
+
+#include <stdbool.h>
+
+#include "mf_dict.h"
+#include "mf_params.h"
+#include "mf_sim.h"
+
+typedef struct mf_watch_settings {
+    bool enabled;
+    double energy_tolerance;  /* fraction of the energy scale */
+    double density_collapse;  /* fraction of n0 */
+} mf_watch_settings;
+
+typedef struct mf_watch {
+    mf_watch_settings s;
+    bool started;
+    double ke0;          /* kinetic energy when the watch started */
+    double work;         /* work of the force modules since then */
+    double pot_scale;    /* sum m |a_ext| L at the start */
+    double power;        /* force power at the last accepted step */
+    double n_start;      /* mean fluid number density at the first check (-1: not yet) */
+    double *acc;         /* scratch: force accelerations, 3 per particle */
+    size_t cap;
+    /* Candidate values of the step being checked (committed on accept). */
+    double next_work, next_power;
+} mf_watch;
+
+extern const mf_param mf_watch_params[];
+extern const size_t mf_watch_nparams;
+
+/* Settings from controlDict's `watch { ... }` (dict may be NULL: defaults). */
+int mf_watch_init(mf_watch *w, const mf_dict *dict, mf_dict *resolved);
+void mf_watch_free(mf_watch *w);
+/* Check the state after a step of dt. 0, or MF_ERR_NUMERIC with a diagnosis. */
+int mf_watch_check(mf_watch *w, const mf_sim *sim, double dt);
+/* The step was accepted: keep its energy bookkeeping. */
+void mf_watch_accept(mf_watch *w);
+
+#endif

@@ -1,0 +1,306 @@
+/* surface.c: `mpsflow surface`, the free surface of a case's snapshots.
+ *
+ *   mpsflow surface [-case DIR] [-time T | -latestTime] [-method levelSet|blobby]
+ *
+ * Reads system/surfaceDict if the case has one (method, levelSetCoeffs {...},
+ * blobbyCoeffs {...}, writePLY, writeOBJ; every key checked against the
+ * modules' parameter tables), reconstructs the selected snapshots in time
+ * order (the level set warm-starts each from the one before) and writes
+ * postProcessing/surface/surface_NNNNNN.{ply,obj,h5} (NNNNNN: the snapshot's
+ * index) with the index postProcessing/surface/surface.xdmf, and the
+ * parameters used in postProcessing/surface/resolvedParameters.
+ *
+ * -time takes OpenFOAM's forms: a time (the nearest snapshot), a list
+ * "0.1,0.2", or a range "0.1:0.5", ":0.5", "0.5:". Without -time or
+ * -latestTime every snapshot is done. */
+#include <errno.h>
+#include <math.h>
+#include <mpi.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "surface/levelset/levelset.h"
+#include "mf_app.h"
+#include "mf_dictio.h"
+#include "mf_error.h"
+#include "mf_hdf5.h"
+#include "mf_mesh_writer.h"
+#include "mf_post.h"
+#include "mf_run.h"
+
+int mf_main_surface(int argc, char **argv, int first);
+
+typedef struct surface_opts {
+    const char *case_dir;
+    const char *time;     /* -time text */
+    bool latest;
+    const char *method;
+    const char *libs;
+    int log_level;
+} surface_opts;
+
+static void surface_usage(FILE *f)
+{
+    fprintf(f,
+            "Usage: mpsflow surface [-case DIR] [-time T | -latestTime] [-method levelSet|blobby]\n"
+            "\n"
+            "Reconstructs the free surface of the fluid particles in DIR/output/snapshot_*.h5\n"
+            "and writes DIR/postProcessing/surface/surface_NNNNNN.{ply,obj,h5} and surface.xdmf\n"
+            "(open it in ParaView next to output/particles.xdmf). Parameters: DIR/system/\n"
+            "surfaceDict (optional): method; levelSetCoeffs {...}; blobbyCoeffs {...};\n"
+            "writePLY yes; writeOBJ yes; (see mpsflow modules levelSet, mpsflow modules blobby).\n"
+            "\n"
+            "Options:\n"
+            "  -case DIR         case directory (default: the current folder)\n"
+            "  -time T           a time (nearest snapshot), a list 0.1,0.2 or a range 0.1:0.5\n"
+            "  -latestTime       only the newest snapshot\n"
+            "  -method NAME      levelSet (eqs. 29-32) or blobby (fast preview), overriding\n"
+            "                    system/surfaceDict\n"
+            "  -libs '(...)'     plugin libraries to load\n"
+            "  -quiet, -verbose  less or more log\n"
+            "  -help             this text\n");
+}
+
+static int parse(int argc, char **argv, int first, surface_opts *o)
+{
+    static const char *const known[] = {"-case", "-time", "-latestTime", "-method", "-libs",
+                                        "-quiet", "-verbose", "-help"};
+    for (int i = first; i < argc; i++) {
+        const char *a = argv[i];
+        if (!strcmp(a, "-help") || !strcmp(a, "--help") || !strcmp(a, "-h"))
+            return 1;
+        if (!strcmp(a, "-latestTime")) {
+            o->latest = true;
+        } else if (!strcmp(a, "-quiet")) {
+            o->log_level = MF_LOG_QUIET;
+        } else if (!strcmp(a, "-verbose")) {
+            o->log_level = MF_LOG_VERBOSE;
+        } else if (!strcmp(a, "-case") || !strcmp(a, "-time") || !strcmp(a, "-method") ||
+                   !strcmp(a, "-libs")) {
+            if (i + 1 >= argc)
+                return MF_ERROR(MF_ERR_INPUT, "option %s needs a value (see mpsflow surface -help)",
+                                a);
+            const char *v = argv[++i];
+            if (!strcmp(a, "-case"))
+                o->case_dir = v;
+            else if (!strcmp(a, "-time"))
+                o->time = v;
+            else if (!strcmp(a, "-method"))
+                o->method = v;
+            else
+                o->libs = v;
+        } else {
+            const char *hint = mf_did_you_mean(a, known, sizeof known / sizeof known[0]);
+            return MF_ERROR(MF_ERR_INPUT, "unknown option '%s'%s%s%s (see mpsflow surface -help)",
+                            a, hint ? "; did you mean '" : "", hint ? hint : "",
+                            hint ? "'?" : "");
+        }
+    }
+    if (o->latest && o->time)
+        return MF_ERROR(MF_ERR_INPUT, "-time and -latestTime exclude each other");
+    return 0;
+}
+
+static int parse_time(const char *text, double *out)
+{
+    char *end;
+    errno = 0;
+    *out = strtod(text, &end);
+    if (end == text || errno || !isfinite(*out))
+        return MF_ERROR(MF_ERR_INPUT, "-time: '%s' is not a time", text);
+    return 0;
+}
+
+/* Mark the snapshots (times t[0..n)) that the -time text selects. */
+static int select_times(const char *spec, const double *t, size_t n, bool *sel)
+{
+    char buf[1024];
+    snprintf(buf, sizeof buf, "%s", spec);
+    for (char *save = NULL, *item = strtok_r(buf, ",", &save); item;
+         item = strtok_r(NULL, ",", &save)) {
+        char *colon = strchr(item, ':');
+        if (colon) {
+            double lo = -INFINITY, hi = INFINITY;
+            *colon = '\0';
+            if (*item)
+                MF_CALL(parse_time(item, &lo));
+            if (colon[1])
+                MF_CALL(parse_time(colon + 1, &hi));
+            double tol = 1e-9 * fmax(1.0, fmax(fabs(isfinite(lo) ? lo : 0), fabs(isfinite(hi) ? hi : 0)));
+            bool any = false;
+            for (size_t k = 0; k < n; k++)
+                if (t[k] >= lo - tol && t[k] <= hi + tol)
+                    sel[k] = any = true;
+            if (!any)
+                return MF_ERROR(MF_ERR_INPUT, "-time %s:%s: no snapshot in that range", item,
+                                colon + 1);
+        } else {
+            double v;
+            MF_CALL(parse_time(item, &v));
+            size_t best = 0;
+            for (size_t k = 1; k < n; k++)
+                if (fabs(t[k] - v) < fabs(t[best] - v))
+                    best = k;
+            sel[best] = true;
+        }
+    }
+    return 0;
+}
+
+static int write_resolved(const char *dir, const mf_dict *resolved)
+{
+    char path[4500], tmp[4510];
+    snprintf(path, sizeof path, "%s/resolvedParameters", dir);
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    FILE *f = fopen(tmp, "w");
+    if (!f)
+        return MF_ERROR(MF_ERR_IO, "%s: cannot open for writing (%s)", tmp, strerror(errno));
+    fprintf(f, "// the parameters `mpsflow surface` used, defaults included\n");
+    int rc = mf_dict_write(resolved, f, 0);
+    if (fclose(f) != 0 && rc == 0)
+        rc = MF_ERROR(MF_ERR_IO, "%s: write failed", tmp);
+    if (rc == 0 && rename(tmp, path) != 0)
+        rc = MF_ERROR(MF_ERR_IO, "cannot rename %s to %s: %s", tmp, path, strerror(errno));
+    return rc;
+}
+
+static int make_dir(const char *path)
+{
+    if (mkdir(path, 0777) != 0 && errno != EEXIST)
+        return MF_ERROR(MF_ERR_IO, "%s: cannot create (%s)", path, strerror(errno));
+    return 0;
+}
+
+static int run_surface(const surface_opts *o, mf_registry *reg, mf_log *log)
+{
+    const char *cd = o->case_dir;
+    char path[4400], out_dir[4400];
+    /* the case's surfaceDict, if any */
+    mf_dict *dict = NULL, *resolved = mf_dict_new("", NULL);
+    if (!resolved)
+        return MF_ERROR(MF_ERR_MEMORY, "out of memory");
+    snprintf(path, sizeof path, "%s/system/surfaceDict", cd);
+    struct stat st;
+    int rc = 0;
+    if (stat(path, &st) == 0)
+        rc = mf_dict_parse_file(path, &dict);
+    int *idx = NULL;
+    size_t n = 0;
+    double *times = NULL;
+    bool *sel = NULL;
+    mf_module m = {0};
+    surface_settings s;
+    mf_mesh mesh;
+    mf_mesh_init(&mesh);
+    static const char *const extra[] = {"FoamFile", NULL};
+    if (rc == 0)
+        rc = surface_open(reg, dict, o->method, extra, resolved, &s, &m);
+    if (rc == 0)
+        rc = mf_list_snapshots(cd, &idx, &n);
+    if (rc == 0) {
+        times = calloc(n, sizeof *times);
+        sel = calloc(n, sizeof *sel);
+        if (!times || !sel)
+            rc = MF_ERROR(MF_ERR_MEMORY, "out of memory");
+    }
+    for (size_t k = 0; k < n && rc == 0; k++) {
+        mf_hdf5_header h;
+        mf_snapshot_path(cd, idx[k], path, sizeof path);
+        rc = mf_hdf5_read_header(path, &h);
+        times[k] = h.time;
+    }
+    if (rc == 0) {
+        if (o->latest)
+            sel[n - 1] = true;
+        else if (o->time)
+            rc = select_times(o->time, times, n, sel);
+        else
+            for (size_t k = 0; k < n; k++)
+                sel[k] = true;
+    }
+    snprintf(out_dir, sizeof out_dir, "%s/postProcessing", cd);
+    if (rc == 0)
+        rc = make_dir(out_dir);
+    snprintf(out_dir, sizeof out_dir, "%s/postProcessing/surface", cd);
+    if (rc == 0)
+        rc = make_dir(out_dir);
+    if (rc == 0)
+        rc = write_resolved(out_dir, resolved);
+    const mf_surface_ops *ops = rc == 0 ? (const mf_surface_ops *)m.info : NULL;
+    int frames = 0;
+    double t_all = mf_wall_seconds();
+    for (size_t k = 0; k < n && rc == 0; k++) {
+        if (!sel[k])
+            continue;
+        mf_snapshot_path(cd, idx[k], path, sizeof path);
+        mf_sim sim;
+        memset(&sim, 0, sizeof sim);
+        sim.log = log;
+        sim.reg = reg;
+        double t0 = mf_wall_seconds();
+        rc = mf_hdf5_read_snapshot(path, &sim);
+        if (rc == 0) {
+            mf_log_printf(log, MF_LOG_NORMAL, "\nTime = %g  (%s)\n", sim.time, path);
+            rc = ops->reconstruct(m.data, &sim, &mesh);
+            if (rc != 0)
+                rc = MF_ERROR(rc, "%s: %s", path, mf_error_message());
+        }
+        if (rc == 0)
+            rc = mf_mesh_write_frame(out_dir, "surface", idx[k], &mesh, s.write_ply,
+                                     s.write_obj);
+        if (rc == 0) {
+            frames++;
+            mf_log_printf(log, MF_LOG_NORMAL,
+                          "surface: %s/surface_%06d (%zu vertices, %zu triangles), %.2f s\n",
+                          out_dir, idx[k], mesh.nverts, mesh.ntris, mf_wall_seconds() - t0);
+        }
+        mf_particles_destroy(sim.p);
+    }
+    if (rc == 0)
+        mf_log_printf(log, MF_LOG_QUIET,
+                      "\nsurface (%s): %d frames in %.2f s, peak memory %.1f MB; ParaView: "
+                      "open %s/surface.xdmf\nEnd\n",
+                      s.method, frames, mf_wall_seconds() - t_all,
+                      mf_peak_memory() / 1048576.0, out_dir);
+    surface_close(&m);
+    mf_mesh_free(&mesh);
+    free(idx);
+    free(times);
+    free(sel);
+    mf_dict_free(dict);
+    mf_dict_free(resolved);
+    return rc;
+}
+
+int mf_main_surface(int argc, char **argv, int first)
+{
+    surface_opts o = {.case_dir = ".", .log_level = MF_LOG_NORMAL};
+    int rc = parse(argc, argv, first, &o);
+    if (rc == 1) {
+        surface_usage(stdout);
+        return 0;
+    }
+    if (rc != 0) {
+        mf_error_print(stderr);
+        return 2;
+    }
+    /* HDF5 is Debian's MPI build: start MPI as the other commands do. */
+    MPI_Init(&argc, &argv);
+    mf_log log;
+    mf_log_init(&log, stdout, o.log_level);
+    log.progress = false;
+    mf_registry *reg = NULL;
+    rc = mf_registry_create(&reg);
+    if (rc == 0)
+        rc = mf_register_builtins(reg);
+    if (rc == 0 && o.libs)
+        rc = mf_app_load_libs_text(reg, o.libs);
+    if (rc == 0)
+        rc = run_surface(&o, reg, &log);
+    if (rc != 0)
+        mf_error_print(stderr);
+    mf_registry_destroy(reg);
+    MPI_Finalize();
+    return rc == 0 ? 0 : 1;
+}

@@ -1,0 +1,23 @@
+/* mf_mesh_import.h: polygon files (OBJ, STL, PLY, OFF and whatever else
+ * Debian's assimp reads) into the plain triangle mesh of core/scene/mf_trimesh.h.
+ *
+ * Polygons are split into triangles; points and lines are counted in
+ * mesh->dropped and left out; node transforms of formats that have them
+ * are applied; corners at the same place are merged (STL repeats them for
+ * every triangle). A missing, empty or unreadable file, a file with no
+ * triangle, or one with a non-finite coordinate is MF_ERR_INPUT or
+ * MF_ERR_IO with a message naming the file. */
+#ifndef MF_MESH_IMPORT_H
+#define MF_MESH_IMPORT_H
+
+#include "mf_trimesh.h"
+
+/* Read the file at path into *out (initialised by the caller). */
+int mf_mesh_import(const char *path, mf_trimesh *out);
+
+/* The reader the scene builder takes: `file` as written in a case, tried
+ * as it is when absolute, else in the folder of the dictionary that names
+ * it (constant/), then in its triSurface/ subfolder (OpenFOAM's place). */
+mf_trimesh_reader mf_mesh_import_reader(void);
+
+#endif

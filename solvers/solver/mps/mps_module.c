@@ -1,0 +1,186 @@
+/* mps_module.c: create and destroy the MPS solver; its ops table. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "force/forces.h"
+#include "mf_error.h"
+#include "mps.h"
+
+static int create_pressure(mps_data *d, mf_sim *sim, const mf_dict *solver_dict)
+{
+    const mf_dict *pd = solver_dict ? mf_dict_subdict(solver_dict, "pressure") : NULL;
+    const char *name = "PCG_BoomerAMG";
+    if (pd)
+        MF_CALL(mf_dict_get_word_or(pd, "solver", name, &name));
+    static const char *const extra[] = {"solver", NULL};
+    MF_CALL(mf_module_prepare(sim->reg, MF_KIND_PRESSURE, name, pd, extra, NULL, &d->pressure));
+    d->pressure_ops = (const mf_pressure_ops *)d->pressure.info;
+    MF_CALL(d->pressure_ops->create(d->pressure.settings, &d->pressure.data));
+    return 0;
+}
+
+int mps_reserve(mps_data *d, size_t n)
+{
+    if (n <= d->cap)
+        return 0;
+    size_t cap = n + n / 4 + 64;
+    d->acc = realloc(d->acc, 3 * cap * sizeof *d->acc);
+    d->grad = realloc(d->grad, 3 * cap * sizeof *d->grad);
+    d->is_fluid = realloc(d->is_fluid, cap);
+    d->in_ppe = realloc(d->in_ppe, cap);
+    d->dirichlet = realloc(d->dirichlet, cap);
+    d->not_dummy = realloc(d->not_dummy, cap);
+    d->row = realloc(d->row, cap * sizeof *d->row);
+    if (!d->acc || !d->grad || !d->is_fluid || !d->in_ppe || !d->dirichlet || !d->not_dummy ||
+        !d->row)
+        return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu particles", n);
+    d->cap = cap;
+    return 0;
+}
+
+int mps_create_data(const mps_settings *s, mf_sim *sim, const mf_dict *solver_dict,
+                    mps_data **out)
+{
+    if (s->periodic_length > 0)
+        return MF_ERROR(MF_ERR_INPUT, "periodicLength: only solver MPS has a periodic axis");
+    mps_data *d = calloc(1, sizeof *d);
+    if (!d)
+        return MF_ERROR(MF_ERR_MEMORY, "out of memory");
+    *out = d;
+    d->s = *s;
+    mf_grid_init(&d->grid);
+    mf_nlist_init(&d->nl_max);
+    mf_nlist_init(&d->nl_nd);
+    mf_nlist_init(&d->nl_grad);
+    mf_nlist_init(&d->nl_lap);
+    MF_CALL(mf_kernel_init(&d->k_nd, sim->dim, sim->l0, s->re_number_density * sim->l0));
+    MF_CALL(mf_kernel_init(&d->k_grad, sim->dim, sim->l0, s->re_gradient * sim->l0));
+    MF_CALL(mf_kernel_init(&d->k_lap, sim->dim, sim->l0, s->re_laplacian * sim->l0));
+    sim->n0 = d->k_nd.n0; /* the NumberDensity field's reference, for the run's watch */
+    d->rho_default = sim->fluid[0].rho;
+    MF_CALL(mf_particles_request_field(sim->p, "Pressure", 1, MF_FIELD_DOUBLE, true,
+                                       &d->f_pressure));
+    MF_CALL(mf_particles_request_field(sim->p, "NumberDensity", 1, MF_FIELD_DOUBLE, true,
+                                       &d->f_number_density));
+    MF_CALL(mf_particles_request_field(sim->p, "Flags", 1, MF_FIELD_INT32, true, &d->f_flags));
+    MF_CALL(create_pressure(d, sim, solver_dict));
+    if (strcmp(s->viscosity, "implicit") == 0)
+        MF_CALL(mps_viscosity_create(d, sim));
+    MF_CALL(mps_reserve(d, sim->p->n));
+    const mf_kernel *ks[3] = {&d->k_nd, &d->k_grad, &d->k_lap};
+    const char *names[3] = {"number density", "gradient", "Laplacian"};
+    for (int k = 0; k < 3; k++)
+        mf_log_printf(sim->log, MF_LOG_NORMAL,
+                      "MPS kernel (%s): re = %g l0, n0 = %.6g, lambda = %.6g l0^2\n", names[k],
+                      ks[k]->re / sim->l0, ks[k]->n0, ks[k]->lambda / (sim->l0 * sim->l0));
+    mf_log_printf(sim->log, MF_LOG_NORMAL, "Pressure solver: %s\n", d->pressure.info->name);
+    return 0;
+}
+
+void mps_destroy_data(mps_data *d)
+{
+    if (!d)
+        return;
+    if (d->pressure_ops && d->pressure.data)
+        d->pressure_ops->destroy(d->pressure.data);
+    mf_module_release(&d->pressure);
+    mps_viscosity_destroy(d->visc);
+    mps_periodic_destroy(d->periodic);
+    mf_grid_free(&d->grid);
+    mf_nlist_free(&d->nl_max);
+    mf_nlist_free(&d->nl_nd);
+    mf_nlist_free(&d->nl_grad);
+    mf_nlist_free(&d->nl_lap);
+    free(d->acc);
+    free(d->grad);
+    free(d->is_fluid);
+    free(d->in_ppe);
+    free(d->dirichlet);
+    free(d->not_dummy);
+    free(d->row);
+    free(d->rhs);
+    free(d->x);
+    free(d->A.rowptr);
+    free(d->A.col);
+    free(d->A.val);
+    free(d);
+}
+
+static int mps_create(const void *settings, mf_sim *sim, const mf_dict *solver_dict, void **data)
+{
+    if (sim->nfluids > 1)
+        return MF_ERROR(MF_ERR_INPUT,
+                        "solver MPS models one fluid, but constant/fluids defines %d (%s, %s%s): "
+                        "use solver multiFluid",
+                        sim->nfluids, sim->fluid[0].name, sim->fluid[1].name,
+                        sim->nfluids > 2 ? ", ..." : "");
+    /* Only this solver has a periodic axis (mps_periodic.c): the composing
+     * solvers call the phases themselves. */
+    mps_settings s = *(const mps_settings *)settings;
+    const double period = s.periodic_length;
+    s.periodic_length = 0;
+    mps_data *d = NULL;
+    int rc = mps_create_data(&s, sim, solver_dict, &d);
+    if (rc == 0 && period > 0) {
+        d->s.periodic_length = period;
+        double rmax = d->k_nd.re;
+        if (d->k_grad.re > rmax) rmax = d->k_grad.re;
+        if (d->k_lap.re > rmax) rmax = d->k_lap.re;
+        rc = mps_periodic_create(d, sim, rmax);
+    }
+    if (rc != 0) {
+        mps_destroy_data(d);
+        return mf_error_trace(rc, __FILE__, __LINE__, __func__);
+    }
+    *data = d;
+    return 0;
+}
+
+static int mps_step(void *data, mf_sim *sim, double dt)
+{
+    MF_CALL(mps_lagrangian_step(data, sim, dt));
+    return 0;
+}
+
+static void mps_destroy(void *data) { mps_destroy_data(data); }
+
+/* The forces' own limit (the capillary step of surfaceTension), if any. */
+static int mps_stable_dt(void *data, const mf_sim *sim, double *dt)
+{
+    (void)data;
+    *dt = mf_forces_stable_dt(sim);
+    return 0;
+}
+
+static void mps_report(void *data, const mf_sim *sim, mf_log *log)
+{
+    const mps_data *d = data;
+    const double attempts = d->attempts > 0 ? (double)d->attempts : 1.0;
+    const double total = d->t_neighbours + d->t_explicit + d->t_assembly + d->t_solve +
+                         d->t_correction;
+    mf_log_printf(log, MF_LOG_QUIET,
+                  "MPS time per step (ms): neighbour search %.3f, explicit %.3f, number density "
+                  "+ assembly %.3f, pressure solve %.3f (AMG setup %.3f, PCG %.3f), correction "
+                  "%.3f; total %.3f\n",
+                  1e3 * d->t_neighbours / attempts, 1e3 * d->t_explicit / attempts,
+                  1e3 * d->t_assembly / attempts, 1e3 * d->t_solve / attempts,
+                  1e3 * d->t_setup / attempts, 1e3 * d->t_pcg / attempts,
+                  1e3 * d->t_correction / attempts, 1e3 * total / attempts);
+    mf_log_printf(log, MF_LOG_QUIET,
+                  "MPS pressure: %ld unknowns in the last solve, %.2f iterations per solve on "
+                  "average\n",
+                  d->ppe_rows,
+                  (double)sim->pressure_iterations / (d->solves > 0 ? (double)d->solves : 1.0));
+    mps_viscosity_report(d->visc, sim, log);
+}
+
+const mf_solver_ops mf_solver_MPS = {
+    .info = {MF_ABI_VERSION, MF_KIND_SOLVER, "MPS",
+             "Moving Particle Semi-implicit method (the paper's Algorithm 1)", mps_params,
+             MPS_NPARAMS, sizeof(mps_settings)},
+    .create = mps_create,
+    .step = mps_step,
+    .destroy = mps_destroy,
+    .stable_dt = mps_stable_dt,
+    .report = mps_report,
+};
