@@ -1,15 +1,26 @@
 /* nlist.c: CSR neighbour lists over the occupied-cell grid of grid.c
  * (mf_neighbours.h). How the grid is built is described in grid.c.
  *
- * List build, two parallel passes over cells:
+ * Candidates of a particle: the cells that meet the box [x - R, x + R] of
+ * its position (R the list radius), at most reach cells away from its own
+ * cell on each axis. Along x those cells are consecutive in key order, so
+ * each row (y, z) of them is one range of sorted particles; a cell turns the
+ * first occupied cell of each of its rows (grid.c) into the boundaries of
+ * every cell of the row once, and each of its particles picks its ranges.
+ * With R up to the cell size that is the 3^dim cells around it; up to twice
+ * the cell size (a list with a skin, mf_neighbours_pairs) the ring beyond
+ * them only where the box reaches into it.
+ *
+ * List build, three parallel passes over cells:
+ *   plan:  candidates per particle, hence the offsets of its candidate bits;
  *   count: test every candidate of every particle, store the outcome as one
  *          bit per candidate and the count per particle;
  *   fill:  after a prefix sum of the counts, turn the set bits into indices.
  * The distance test thus runs once per candidate, and both passes read the
  * same bits, so they cannot disagree. The j's of a particle come in row and
- * cell order, the same for any thread count. When the bits would take too
- * much memory (cells much larger than the radius) the fill pass repeats the
- * distance test instead.
+ * cell order, that is ascending (cell key, index), the same for any thread
+ * count. When the bits would take too much memory (cells much larger than
+ * the radius) the fill pass repeats the distance test instead.
  */
 #include "neighbours_internal.h"
 
@@ -34,7 +45,7 @@ size_t mf_nlist_memory(const mf_nlist *nl)
 {
     if (!nl)
         return 0;
-    return nl->cap_n * sizeof(size_t) + nl->cap_j * sizeof(uint32_t) + nl->work_bytes;
+    return nl->cap_n * sizeof(uint32_t) + nl->cap_j * sizeof(uint32_t) + nl->work_bytes;
 }
 
 static int ensure_start(mf_nlist *nl, size_t n)
@@ -43,7 +54,7 @@ static int ensure_start(mf_nlist *nl, size_t n)
         return 0;
     nl->cap_n = 0;
     size_t cap = with_headroom(n + 1);
-    MF_CALL(replace_buffer((void **)&nl->start, cap, sizeof(size_t), "list starts"));
+    MF_CALL(replace_buffer((void **)&nl->start, cap, sizeof(uint32_t), "list starts"));
     nl->cap_n = cap;
     return 0;
 }
@@ -59,7 +70,8 @@ static int ensure_entries(mf_nlist *nl, size_t count)
     return 0;
 }
 
-/* Scratch of at least `bytes`, 8-byte aligned (malloc's alignment). */
+/* Scratch of at least `bytes`, 8-byte aligned (malloc's alignment); its
+ * contents do not survive a call that grows it. */
 static int ensure_work(mf_nlist *nl, size_t bytes)
 {
     if (nl->work && !needs_realloc(nl->work_bytes, bytes))
@@ -71,12 +83,22 @@ static int ensure_work(mf_nlist *nl, size_t bytes)
     return 0;
 }
 
-/* start[i + 1] holds the count of i on entry; start becomes offsets. */
-static void counts_to_offsets(size_t *start, size_t n)
+/* start[i + 1] holds the count of i on entry; start becomes offsets. The
+ * offsets are 32-bit: more than 2^32 - 1 entries on one rank is an error. */
+static int counts_to_offsets(uint32_t *start, size_t n)
 {
+    uint64_t sum = 0;
     start[0] = 0;
-    for (size_t i = 0; i < n; i++)
-        start[i + 1] += start[i];
+    for (size_t i = 0; i < n; i++) {
+        sum += start[i + 1];
+        if (sum >= UINT32_MAX)
+            return MF_ERROR(MF_ERR_MEMORY,
+                            "neighbour list of %zu particles has more than 2^32 entries: run "
+                            "on more ranks or with smaller radii",
+                            n);
+        start[i + 1] = (uint32_t)sum;
+    }
+    return 0;
 }
 
 /* ---- neighbour lists: the distance test ---------------------------------- */
@@ -204,7 +226,7 @@ KERNEL size_t test_candidates(const pair_test *t, const uint32_t *rows, int nrow
 
 /* Append the particle indices of the set bits (other than k itself). */
 KERNEL size_t decode_bits(const uint64_t *words, size_t nwords, const uint32_t *rows,
-                          const size_t row_bit[MAX_ROWS + 1], const size_t *order, size_t k,
+                          const size_t row_bit[MAX_ROWS + 1], const uint32_t *order, size_t k,
                           uint32_t *out)
 {
     size_t w = 0;
@@ -218,7 +240,7 @@ KERNEL size_t decode_bits(const uint64_t *words, size_t nwords, const uint32_t *
                 r++;
             size_t m = rows[2 * r] + (bit - row_bit[r]);
             if (m != k)
-                out[w++] = (uint32_t)order[m];
+                out[w++] = order[m];
         }
     }
     return w;
@@ -226,7 +248,7 @@ KERNEL size_t decode_bits(const uint64_t *words, size_t nwords, const uint32_t *
 
 /* Fallback fill without bits: repeat the distance test. */
 KERNEL size_t retest_candidates(const pair_test *t, const uint32_t *rows, int nrows,
-                                const size_t *order, size_t k, const double xi[3], int dim,
+                                const uint32_t *order, size_t k, const double xi[3], int dim,
                                 uint32_t *out)
 {
     size_t w = 0;
@@ -236,51 +258,187 @@ KERNEL size_t retest_candidates(const pair_test *t, const uint32_t *rows, int nr
         for (; m + 2 <= b; m += 2) {
             vec2i h = within2(t, m, xi, dim);
             if (h[0] && m != k)
-                out[w++] = (uint32_t)order[m];
+                out[w++] = order[m];
             if (h[1] && m + 1 != k)
-                out[w++] = (uint32_t)order[m + 1];
+                out[w++] = order[m + 1];
         }
         if (m < b && within1(t, m, xi, dim) && m != k)
-            out[w++] = (uint32_t)order[m];
+            out[w++] = order[m];
     }
     return w;
 }
 
-/* ---- neighbour lists: the two passes -------------------------------------- */
+/* ---- neighbour lists: candidate rows -------------------------------------- */
+
+/* The cells around one cell: for each of its rows r, bound[r * stride + m]
+ * is the first sorted particle of the cell at x = ix - reach + m (m = 0 ..
+ * 2 reach), and bound[r * stride + 2 reach + 1] the end of the last one;
+ * an unoccupied cell starts where the next occupied one does. */
+typedef struct cell_bounds {
+    uint32_t b[MAX_ROWS * 6];
+    int stride;              /* 2 reach + 2 */
+    int64_t ix, iy, iz;      /* the cell's coordinates */
+} cell_bounds;
+
+static inline void bounds_of_cell(const mf_grid *g, size_t c, int nrows, cell_bounds *cb)
+{
+    const uint64_t key = g->cell_key[c];
+    const int reach = g->reach;
+    cb->stride = 2 * reach + 2;
+    cb->ix = (int64_t)(key & AXIS_MASK);
+    cb->iy = (int64_t)((key >> MF_GRID_AXIS_BITS) & AXIS_MASK);
+    cb->iz = (int64_t)(key >> (2 * MF_GRID_AXIS_BITS));
+    const uint32_t *rows = g->cell_rows + c * (size_t)nrows;
+    for (int r = 0; r < nrows; r++) {
+        uint32_t *bd = cb->b + r * cb->stride;
+        if (rows[r] == EMPTY_SLOT) {
+            for (int m = 0; m < cb->stride; m++)
+                bd[m] = 0;
+            continue;
+        }
+        size_t q = rows[r];
+        const uint64_t row_key = g->cell_key[q] >> MF_GRID_AXIS_BITS;
+        for (int m = 0; m < cb->stride; m++) {
+            const int64_t x = cb->ix - reach + m;
+            while (q < g->ncells && g->cell_key[q] >> MF_GRID_AXIS_BITS == row_key &&
+                   (int64_t)(g->cell_key[q] & AXIS_MASK) < x)
+                q++;
+            bd[m] = g->cell_start[q];
+        }
+    }
+}
+
+/* Offsets (cells from the particle's own) of the first and last cell that
+ * the interval [x - R, x + R] meets on one axis, within [-reach, reach]. The
+ * radius is taken a hair larger so that rounding cannot drop a cell. */
+static inline void axis_span(double x, double origin, double inv_width, double radius,
+                             int64_t own, int reach, int *lo, int *hi)
+{
+    const double r = radius * (1.0 + 1e-12);
+    int64_t a = (int64_t)floor((x - r - origin) * inv_width) - own;
+    int64_t b = (int64_t)floor((x + r - origin) * inv_width) - own;
+    *lo = a < -reach ? -reach : a > 0 ? 0 : (int)a;
+    *hi = b > reach ? reach : b < 0 ? 0 : (int)b;
+}
+
+/* The candidate ranges of sorted particle k of the cell: (dz, dy) rows
+ * ascending, cells along x ascending, so that hits come in key order. */
+KERNEL int particle_rows(const mf_grid *g, const cell_bounds *cb, const double xi[3],
+                         double radius, double inv_width, int dim, uint32_t *rows)
+{
+    const int reach = g->reach, w = 2 * reach + 1;
+    int xl, xh, yl, yh, zl = 0, zh = 0;
+    axis_span(xi[0], g->origin[0], inv_width, radius, cb->ix, reach, &xl, &xh);
+    axis_span(xi[1], g->origin[1], inv_width, radius, cb->iy, reach, &yl, &yh);
+    if (dim == 3)
+        axis_span(xi[2], g->origin[2], inv_width, radius, cb->iz, reach, &zl, &zh);
+    int n = 0;
+    for (int dz = zl; dz <= zh; dz++)
+        for (int dy = yl; dy <= yh; dy++) {
+            const int r = dim == 3 ? (dz + reach) * w + (dy + reach) : dy + reach;
+            const uint32_t *bd = cb->b + r * cb->stride;
+            const uint32_t a = bd[xl + reach], b = bd[xh + reach + 1];
+            if (a < b) {
+                rows[2 * n] = a;
+                rows[2 * n + 1] = b;
+                n++;
+            }
+        }
+    return n;
+}
+
+/* ---- neighbour lists: the three passes ------------------------------------ */
 
 typedef struct {
     const mf_grid *g;
     pair_test t;
-    int nrows;
-    const size_t *cell_word; /* ncells + 1 word offsets, or NULL: no bits */
+    double radius, inv_width;
+    int nrows;               /* rows stored per cell */
+    size_t *word;            /* np + 1 word offsets per sorted particle, or NULL: no bits */
     uint64_t *bits;
 } list_build;
 
-/* Pass 1: start[i + 1] = number of neighbours of i; bits if kept. */
-KERNEL void count_cell(const list_build *lb, size_t c, int dim, bool keep_bits, size_t *start)
+static inline void load_position(const pair_test *t, size_t k, double xi[3])
+{
+    xi[0] = t->sx[k];
+    xi[1] = t->sy[k];
+    xi[2] = t->sz[k];
+}
+
+/* Pass 0: word[k + 1] = words of sorted particle k. */
+KERNEL void plan_cell(const list_build *lb, size_t c, int dim)
 {
     const mf_grid *g = lb->g;
-    const uint32_t *rows = g->cell_rows + (size_t)c * 2 * lb->nrows;
-    const size_t k0 = g->cell_start[c], k1 = g->cell_start[c + 1];
-    uint64_t *words = NULL;
-    size_t nwords = 0;
-    if (keep_bits) {
-        words = lb->bits + lb->cell_word[c];
-        nwords = (lb->cell_word[c + 1] - lb->cell_word[c]) / (k1 - k0);
-    }
-    for (size_t k = k0; k < k1; k++) {
-        const double xi[3] = {lb->t.sx[k], lb->t.sy[k], lb->t.sz[k]};
-        size_t hits = test_candidates(&lb->t, rows, lb->nrows, xi, dim, keep_bits,
-                                      keep_bits ? words + (k - k0) * nwords : NULL);
-        start[g->order[k] + 1] = hits - 1; /* minus the particle itself */
+    cell_bounds cb;
+    bounds_of_cell(g, c, lb->nrows, &cb);
+    uint32_t rows[2 * MAX_ROWS];
+    for (size_t k = g->cell_start[c]; k < g->cell_start[c + 1]; k++) {
+        double xi[3];
+        load_position(&lb->t, k, xi);
+        int n = particle_rows(g, &cb, xi, lb->radius, lb->inv_width, dim, rows);
+        lb->word[k + 1] = words_per_particle(rows, n);
     }
 }
 
-static void count_pass(const list_build *lb, size_t *start)
+/* Pass 1: start[i + 1] = number of neighbours of i; bits if kept. */
+KERNEL void count_cell(const list_build *lb, size_t c, int dim, bool keep_bits, uint32_t *start)
+{
+    const mf_grid *g = lb->g;
+    cell_bounds cb;
+    bounds_of_cell(g, c, lb->nrows, &cb);
+    uint32_t rows[2 * MAX_ROWS];
+    for (size_t k = g->cell_start[c]; k < g->cell_start[c + 1]; k++) {
+        double xi[3];
+        load_position(&lb->t, k, xi);
+        int n = particle_rows(g, &cb, xi, lb->radius, lb->inv_width, dim, rows);
+        size_t hits = test_candidates(&lb->t, rows, n, xi, dim, keep_bits,
+                                      keep_bits ? lb->bits + lb->word[k] : NULL);
+        start[g->order[k] + 1] = (uint32_t)(hits - 1); /* minus the particle itself */
+    }
+}
+
+/* Pass 2: j's at the offsets of pass 1, from the bits or by testing again. */
+KERNEL void fill_cell(const list_build *lb, size_t c, int dim, const uint32_t *start,
+                      uint32_t *jlist)
+{
+    const mf_grid *g = lb->g;
+    cell_bounds cb;
+    bounds_of_cell(g, c, lb->nrows, &cb);
+    uint32_t rows[2 * MAX_ROWS];
+    for (size_t k = g->cell_start[c]; k < g->cell_start[c + 1]; k++) {
+        double xi[3];
+        load_position(&lb->t, k, xi);
+        int n = particle_rows(g, &cb, xi, lb->radius, lb->inv_width, dim, rows);
+        uint32_t *out = jlist + start[g->order[k]];
+        if (lb->word) {
+            size_t row_bit[MAX_ROWS + 1];
+            row_bit_offsets(rows, n, row_bit);
+            decode_bits(lb->bits + lb->word[k], lb->word[k + 1] - lb->word[k], rows, row_bit,
+                        g->order, k, out);
+        } else {
+            retest_candidates(&lb->t, rows, n, g->order, k, xi, dim, out);
+        }
+    }
+}
+
+static void plan_pass(const list_build *lb)
 {
     const size_t ncells = lb->g->ncells;
     const int dim = lb->g->dim;
-    const bool keep_bits = lb->cell_word != NULL;
+#pragma omp parallel for schedule(dynamic, 32)
+    for (size_t c = 0; c < ncells; c++) {
+        if (dim == 3)
+            plan_cell(lb, c, 3);
+        else
+            plan_cell(lb, c, 2);
+    }
+}
+
+static void count_pass(const list_build *lb, uint32_t *start)
+{
+    const size_t ncells = lb->g->ncells;
+    const int dim = lb->g->dim;
+    const bool keep_bits = lb->word != NULL;
 #pragma omp parallel for schedule(dynamic, 32)
     for (size_t c = 0; c < ncells; c++) {
         /* Literals let the compiler specialise the kernels. */
@@ -295,31 +453,7 @@ static void count_pass(const list_build *lb, size_t *start)
     }
 }
 
-/* Pass 2: j's at the offsets of pass 1, from the bits or by testing again. */
-KERNEL void fill_cell(const list_build *lb, size_t c, int dim, const size_t *start,
-                      uint32_t *jlist)
-{
-    const mf_grid *g = lb->g;
-    const uint32_t *rows = g->cell_rows + (size_t)c * 2 * lb->nrows;
-    const size_t k0 = g->cell_start[c], k1 = g->cell_start[c + 1];
-    size_t row_bit[MAX_ROWS + 1], nwords = 0;
-    if (lb->cell_word) {
-        row_bit_offsets(rows, lb->nrows, row_bit);
-        nwords = (lb->cell_word[c + 1] - lb->cell_word[c]) / (k1 - k0);
-    }
-    for (size_t k = k0; k < k1; k++) {
-        uint32_t *out = jlist + start[g->order[k]];
-        if (lb->cell_word) {
-            const uint64_t *words = lb->bits + lb->cell_word[c] + (k - k0) * nwords;
-            decode_bits(words, nwords, rows, row_bit, g->order, k, out);
-        } else {
-            const double xi[3] = {lb->t.sx[k], lb->t.sy[k], lb->t.sz[k]};
-            retest_candidates(&lb->t, rows, lb->nrows, g->order, k, xi, dim, out);
-        }
-    }
-}
-
-static void fill_pass(const list_build *lb, const size_t *start, uint32_t *jlist)
+static void fill_pass(const list_build *lb, const uint32_t *start, uint32_t *jlist)
 {
     const size_t ncells = lb->g->ncells;
     const int dim = lb->g->dim;
@@ -332,33 +466,39 @@ static void fill_pass(const list_build *lb, const size_t *start, uint32_t *jlist
     }
 }
 
-/* Lay out the candidate bits: word offsets per cell at the start of the
- * scratch, the bits after them. Leaves lb->cell_word NULL (no bits) when
+/* Lay out the candidate bits: word offsets per sorted particle at the start
+ * of the scratch, the bits after them. Leaves lb->word NULL (no bits) when
  * they would exceed MAX_BIT_WORDS_PER_PARTICLE on average. */
 static int plan_bits(mf_nlist *nl, list_build *lb)
 {
-    const mf_grid *g = lb->g;
-    const size_t ncells = g->ncells;
-    size_t total = 0;
-    for (size_t c = 0; c < ncells; c++) {
-        const uint32_t *rows = g->cell_rows + c * 2 * lb->nrows;
-        total += words_per_particle(rows, lb->nrows) * (g->cell_start[c + 1] - g->cell_start[c]);
-    }
-    lb->cell_word = NULL;
+    const size_t np = lb->g->np;
+    lb->word = NULL;
     lb->bits = NULL;
-    if (total > MAX_BIT_WORDS_PER_PARTICLE * g->np)
+    /* Grow only: the bits that follow the offsets need the space again. */
+    if (!nl->work || nl->work_bytes < (np + 1) * sizeof(size_t))
+        MF_CALL(ensure_work(nl, (np + 1) * sizeof(size_t)));
+    size_t *word = nl->work;
+    lb->word = word;
+    plan_pass(lb);
+    word[0] = 0;
+    for (size_t k = 0; k < np; k++)
+        word[k + 1] += word[k];
+    const size_t total = word[np];
+    if (total > MAX_BIT_WORDS_PER_PARTICLE * np) {
+        lb->word = NULL;
         return 0;
-    MF_CALL(ensure_work(nl, (ncells + 1 + total) * sizeof(uint64_t)));
-    size_t *cell_word = nl->work;
-    size_t offset = 0;
-    for (size_t c = 0; c < ncells; c++) {
-        const uint32_t *rows = g->cell_rows + c * 2 * lb->nrows;
-        cell_word[c] = offset;
-        offset += words_per_particle(rows, lb->nrows) * (g->cell_start[c + 1] - g->cell_start[c]);
     }
-    cell_word[ncells] = offset;
-    lb->cell_word = cell_word;
-    lb->bits = (uint64_t *)nl->work + (ncells + 1);
+    const size_t had = nl->work_bytes;
+    MF_CALL(ensure_work(nl, (np + 1) * sizeof(size_t) + total * sizeof(uint64_t)));
+    if (nl->work != word || nl->work_bytes != had) { /* replaced: plan again into it */
+        word = nl->work;
+        lb->word = word;
+        plan_pass(lb);
+        word[0] = 0;
+        for (size_t k = 0; k < np; k++)
+            word[k + 1] += word[k];
+    }
+    lb->bits = (uint64_t *)(word + np + 1);
     return 0;
 }
 
@@ -366,10 +506,11 @@ int mf_nlist_build(mf_nlist *nl, const mf_grid *g, const mf_particles *p, double
 {
     if (!nl || !g || !p)
         return MF_ERROR(MF_ERR_INPUT, "mf_nlist_build: NULL list, grid or particles");
-    if (!(radius * radius > 0.0) || radius > g->cell_size)
+    if (!(radius * radius > 0.0) || radius > g->reach * g->cell_size)
         return MF_ERROR(MF_ERR_INPUT,
-                        "neighbour radius %g must be positive and at most the cell size %g",
-                        radius, g->cell_size);
+                        "neighbour radius %g must be positive and at most %d times the cell "
+                        "size %g",
+                        radius, g->reach, g->cell_size);
     if (g->np != p->n || g->dim != p->dim)
         return MF_ERROR(MF_ERR_INPUT,
                         "grid is stale: built for %zu particles in %d-D, now %zu in %d-D "
@@ -383,15 +524,47 @@ int mf_nlist_build(mf_nlist *nl, const mf_grid *g, const mf_particles *p, double
     list_build lb = {
         .g = g,
         .t = {g->spos, g->spos + n, g->spos + 2 * n, radius * radius},
-        .nrows = rows_per_cell(g->dim),
+        .radius = radius,
+        .inv_width = 1.0 / binning_width(g->cell_size),
+        .nrows = rows_per_cell(g->dim, g->reach),
     };
     MF_CALL(plan_bits(nl, &lb));
     count_pass(&lb, nl->start);
-    counts_to_offsets(nl->start, n);
+    MF_CALL(counts_to_offsets(nl->start, n));
     MF_CALL(ensure_entries(nl, nl->start[n] > 0 ? nl->start[n] : 1));
     fill_pass(&lb, nl->start, nl->j);
     nl->n = n;
     return 0;
+}
+
+/* ---- order ----------------------------------------------------------------- */
+
+static inline bool before(const uint64_t *keys, uint32_t a, uint32_t b)
+{
+    return keys[a] < keys[b] || (keys[a] == keys[b] && a < b);
+}
+
+void mf_nlist_sort(mf_nlist *nl, const uint64_t *keys)
+{
+    const long n = (long)nl->n;
+    const uint32_t *start = nl->start;
+    uint32_t *jl = nl->j;
+#pragma omp parallel for schedule(dynamic, 256)
+    for (long i = 0; i < n; i++) {
+        uint32_t *e = jl + start[i];
+        const uint32_t m = start[i + 1] - start[i];
+        for (uint32_t a = 1; a < m; a++) {
+            const uint32_t v = e[a];
+            if (!before(keys, v, e[a - 1]))
+                continue;
+            uint32_t b = a;
+            do {
+                e[b] = e[b - 1];
+                b--;
+            } while (b > 0 && before(keys, v, e[b - 1]));
+            e[b] = v;
+        }
+    }
 }
 
 /* ---- filtering ------------------------------------------------------------ */
@@ -429,16 +602,16 @@ int mf_nlist_filter(mf_nlist *nl, const mf_nlist *from, const mf_particles *p, d
     const double r2 = radius * radius;
     const double *pos = p->pos;
     const int dim = p->dim;
-    size_t *start = nl->start;
+    uint32_t *start = nl->start;
 
 #pragma omp parallel for schedule(dynamic, 256)
     for (size_t i = 0; i < n; i++) {
         size_t count = 0;
         for (size_t e = from->start[i]; e < from->start[i + 1]; e++)
             count += distance2(pos, dim, i, from->j[e]) < r2;
-        start[i + 1] = count;
+        start[i + 1] = (uint32_t)count;
     }
-    counts_to_offsets(start, n);
+    MF_CALL(counts_to_offsets(start, n));
     MF_CALL(ensure_entries(nl, start[n] > 0 ? start[n] : 1));
     uint32_t *jlist = nl->j;
 #pragma omp parallel for schedule(dynamic, 256)
