@@ -96,10 +96,11 @@ int mf_grid_locality_order(const mf_grid *g, size_t *perm);
 size_t mf_grid_memory(const mf_grid *g);
 /* Occupied cell containing point x, or -1 (empty cell or outside the box). */
 long mf_grid_point_cell(const mf_grid *g, const double x[3]);
-/* keys[i] = the key of particle i's cell in the grid mf_grid_build(p,
- * cell_size) would make (same origin, same rounding), for i in [0, p->n).
- * Fails as mf_grid_build does on a non-finite position. */
-int mf_grid_keys(const mf_particles *p, double cell_size, uint64_t *keys);
+/* keys[i] for i in [0, p->n): the cells of the grid mf_grid_build(p,
+ * cell_size) would make (same origin, same rounding) in key order, and with
+ * *packed the index too (keys[i] < keys[j] exactly when (cell, i) comes
+ * before (cell, j)). Fails as mf_grid_build does on a non-finite position. */
+int mf_grid_keys(const mf_particles *p, double cell_size, uint64_t *keys, bool *packed);
 
 void mf_nlist_init(mf_nlist *nl);
 void mf_nlist_free(mf_nlist *nl);
@@ -109,12 +110,16 @@ void mf_nlist_free(mf_nlist *nl);
  * the grid was built from. The j's of each i are in the grid's order (see
  * the top of this file), the same for any thread count. */
 int mf_nlist_build(mf_nlist *nl, const mf_grid *g, const mf_particles *p, double radius);
+/* The same list and, in one pass, its sub-list of the pairs closer than
+ * sub_radius (<= radius) in sub. */
+int mf_nlist_build_pair(mf_nlist *nl, mf_nlist *sub, const mf_grid *g, const mf_particles *p,
+                        double radius, double sub_radius);
 /* The sub-list of `from` closer than radius (radius <= from->radius). */
 int mf_nlist_filter(mf_nlist *nl, const mf_nlist *from, const mf_particles *p, double radius);
-/* Put the j's of every i in ascending (keys[j], j) (keys from mf_grid_keys):
- * the order a fresh build at the positions of the keys gives. Cheap when the
- * list is nearly in order already (insertion sort). */
-void mf_nlist_sort(mf_nlist *nl, const uint64_t *keys);
+/* Put the j's of every i in ascending (keys[j], j) (keys and packed from
+ * mf_grid_keys): the order a fresh build at the positions of the keys
+ * gives. Cheap when the list is nearly in order already (insertion sort). */
+void mf_nlist_sort(mf_nlist *nl, const uint64_t *keys, bool packed);
 size_t mf_nlist_memory(const mf_nlist *nl);
 
 /* ---- the neighbour service --------------------------------------------- */

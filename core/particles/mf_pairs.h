@@ -73,12 +73,13 @@ MF_ENGINE void mf_pairs_row(const mf_pairs *v, size_t i, const uint8_t *jmask,
                             mf_pair_kernel kernel, const void *ctx, void *acc)
 {
     const double *pos = v->pos;
+    const uint32_t *jl = v->j;
     const double xi = pos[3 * i], yi = pos[3 * i + 1], zi = pos[3 * i + 2];
     const double r2max = v->r2;
     mf_pair pr;
     pr.i = i;
     for (uint32_t k = v->start[i], end = v->start[i + 1]; k < end; k++) {
-        const size_t j = v->j[k];
+        const size_t j = jl[k];
         if (jmask && !jmask[j])
             continue;
         const double *xj = pos + 3 * j;
@@ -95,6 +96,42 @@ MF_ENGINE void mf_pairs_row(const mf_pairs *v, size_t i, const uint8_t *jmask,
         if (!kernel(acc, ctx, &pr))
             break;
     }
+}
+
+/* The pairs of particle i as mf_pairs_row finds them, into buf (at most
+ * cap; the count found is returned even when larger, and then buf holds the
+ * first cap): a kernel that needs two passes over a row (a minimum, then a
+ * sum) runs them over the buffer, finding the pairs once. */
+MF_ENGINE size_t mf_pairs_gather(const mf_pairs *v, size_t i, const uint8_t *jmask,
+                                 mf_pair *buf, size_t cap)
+{
+    const double *pos = v->pos;
+    const uint32_t *jl = v->j;
+    const double xi = pos[3 * i], yi = pos[3 * i + 1], zi = pos[3 * i + 2];
+    const double r2max = v->r2;
+    size_t n = 0;
+    for (uint32_t k = v->start[i], end = v->start[i + 1]; k < end; k++) {
+        const size_t j = jl[k];
+        if (jmask && !jmask[j])
+            continue;
+        const double *xj = pos + 3 * j;
+        const double dx = xj[0] - xi, dy = xj[1] - yi, dz = xj[2] - zi;
+        const double r2 = dx * dx + dy * dy + dz * dz;
+        if (!(r2 < r2max))
+            continue;
+        if (n < cap) {
+            mf_pair *pr = &buf[n];
+            pr->i = i;
+            pr->j = j;
+            pr->r[0] = dx;
+            pr->r[1] = dy;
+            pr->r[2] = dz;
+            pr->r2 = r2;
+            pr->len = sqrt(r2);
+        }
+        n++;
+    }
+    return n;
 }
 
 /* Computes and stores the result of particle i. */
@@ -137,18 +174,20 @@ MF_ENGINE size_t mf_pairs_row_count(const mf_pairs *v, size_t i, const uint8_t *
                                     mf_pair_test test, const void *ctx, const long *col_of)
 {
     const double *pos = v->pos;
+    const uint32_t *jl = v->j;
+    const double r2max = v->r2;
     const double xi = pos[3 * i], yi = pos[3 * i + 1], zi = pos[3 * i + 2];
     size_t count = 1;
     mf_pair pr;
     pr.i = i;
     for (uint32_t k = v->start[i], end = v->start[i + 1]; k < end; k++) {
-        const size_t j = v->j[k];
+        const size_t j = jl[k];
         if ((jmask && !jmask[j]) || col_of[j] < 0)
             continue;
         const double *xj = pos + 3 * j;
         const double dx = xj[0] - xi, dy = xj[1] - yi, dz = xj[2] - zi;
         const double r2 = dx * dx + dy * dy + dz * dz;
-        if (!(r2 < v->r2))
+        if (!(r2 < r2max))
             continue;
         if (test) {
             pr.j = j;
@@ -175,20 +214,26 @@ MF_ENGINE double mf_pairs_row_assemble(const mf_pairs *v, size_t i, const uint8_
                                        const mf_rows *rows, size_t row)
 {
     const double *pos = v->pos;
+    const uint32_t *jl = v->j;
+    const double r2max = v->r2;
+    const long *col_of = rows->col_of;
+    int64_t *col = rows->col;
+    double *val = rows->val;
+    const int64_t offset = rows->col_offset;
     const double xi = pos[3 * i], yi = pos[3 * i + 1], zi = pos[3 * i + 2];
     size_t at = rows->rowptr[row];
-    rows->col[at++] = rows->col_offset + rows->col_of[i];
+    col[at++] = offset + col_of[i];
     double sum = 0.0;
     mf_pair pr;
     pr.i = i;
     for (uint32_t k = v->start[i], end = v->start[i + 1]; k < end; k++) {
-        const size_t j = v->j[k];
+        const size_t j = jl[k];
         if (jmask && !jmask[j])
             continue;
         const double *xj = pos + 3 * j;
         const double dx = xj[0] - xi, dy = xj[1] - yi, dz = xj[2] - zi;
         const double r2 = dx * dx + dy * dy + dz * dz;
-        if (!(r2 < v->r2))
+        if (!(r2 < r2max))
             continue;
         pr.j = j;
         pr.r[0] = dx;
@@ -200,10 +245,10 @@ MF_ENGINE double mf_pairs_row_assemble(const mf_pairs *v, size_t i, const uint8_
             continue;
         const double a = coef(ctx, &pr);
         sum += a;
-        const long c = rows->col_of[j];
+        const long c = col_of[j];
         if (c >= 0) {
-            rows->col[at] = rows->col_offset + c;
-            rows->val[at++] = -a;
+            col[at] = offset + c;
+            val[at++] = -a;
         } else if (known) {
             known(acc, ctx, &pr, a);
         }
@@ -211,43 +256,44 @@ MF_ENGINE double mf_pairs_row_assemble(const mf_pairs *v, size_t i, const uint8_
     return sum;
 }
 
-/* Writes row r (of the particle i with col_of[i] == r) of a matrix; returns
- * false to report the row as failed (the assembly goes on; the smallest
- * failed particle is reported). */
+/* The entries of the row of particle i (mf_pairs_row_count with the
+ * assembly's kernels), and the writing of its row r (of the particle i with
+ * col_of[i] == r; mf_pairs_row_assemble, then the diagonal and the
+ * right-hand side). A row function returns false to report the row as
+ * failed: the assembly goes on, and the smallest failed particle is
+ * reported. Both are called through the pointer once a row; the kernels
+ * inside them are inlined. */
+typedef size_t (*mf_count_row_fn)(const void *ctx, size_t i);
 typedef bool (*mf_assemble_row_fn)(const void *ctx, size_t i, size_t row);
+/* Called between the passes with the entry count: sizes the column and
+ * value arrays; nonzero stops the assembly. */
+typedef int (*mf_assemble_sized_fn)(void *ctx, size_t nnz);
 
 /* The matrix of the owned particles i with col_of[i] >= 0 (their rows in
  * particle order: col_of[i] = 0, 1, ... over them): a parallel count pass
- * fills rows->rowptr, then a parallel pass calls row(ctx, i, r) with the
- * offsets ready. Returns the first failed particle, or SIZE_MAX. The caller
- * sizes rows->col and rows->val after the count: count_done(ctx, nnz) is
- * called between the passes and returns nonzero to stop. */
-typedef int (*mf_assemble_sized_fn)(void *ctx, size_t nnz);
-
-MF_ENGINE int mf_pairs_assemble(const mf_pairs *v, const uint8_t *jmask, mf_pair_test test,
-                                const void *ctx, mf_rows *rows, size_t nrows,
-                                mf_assemble_sized_fn sized, void *sized_ctx,
-                                mf_assemble_row_fn row, size_t *failed)
+ * fills rowptr, then sized(), then a parallel pass writes the rows. Returns
+ * in *failed the first failed particle, or SIZE_MAX. */
+MF_ENGINE int mf_pairs_assemble(const mf_pairs *v, const long *col_of, size_t *rowptr,
+                                size_t nrows, mf_count_row_fn count, mf_assemble_sized_fn sized,
+                                mf_assemble_row_fn row, void *ctx, size_t *failed)
 {
     const long n = (long)v->ni;
-    const long *col_of = rows->col_of;
-    size_t *rowptr = rows->rowptr;
 #pragma omp parallel for schedule(static)
     for (long i = 0; i < n; i++) {
         const long r = col_of[i];
         if (r >= 0)
-            rowptr[r + 1] = mf_pairs_row_count(v, (size_t)i, jmask, test, ctx, col_of);
+            rowptr[r + 1] = count(ctx, (size_t)i);
     }
     rowptr[0] = 0;
     for (size_t r = 0; r < nrows; r++)
         rowptr[r + 1] += rowptr[r];
-    int rc = sized(sized_ctx, rowptr[nrows]);
+    int rc = sized(ctx, rowptr[nrows]);
     if (rc != 0)
         return rc;
     size_t first = SIZE_MAX;
 #pragma omp parallel for schedule(static) reduction(min : first)
     for (long i = 0; i < n; i++) {
-        const long r = rows->col_of[i];
+        const long r = col_of[i];
         if (r >= 0 && !row(ctx, (size_t)i, (size_t)r) && (size_t)i < first)
             first = (size_t)i;
     }

@@ -11,14 +11,16 @@
  * is the order a fresh build would give: sums come out bit for bit the same
  * whether a list was kept or built.
  *
- * The skin adapts to what a list has to survive: the largest displacement
- * it survived in its life (or, if it survived none, the one it failed at),
- * times SKIN_FACTOR, between the set bounds. The MPS step builds at r*
- * (after the explicit phase moved the fluid by u* dt) and meets the next
- * order point at r^n of the next step, after the correction moved it by u'
- * dt only: the skin settles at a few times that small displacement, one
+ * The skin adapts to the displacement a list meets at the first order point
+ * after its build, times SKIN_FACTOR, between the set bounds (a list that
+ * fails there takes the displacement it failed at). The MPS step builds at
+ * r* (after the explicit phase moved the fluid by u* dt) and meets the next
+ * order point at r^n of the next step, after the correction moved it by
+ * u' dt only: the skin settles at a few times that small displacement, one
  * build a step instead of two, the list only slightly longer. A slow flow
- * keeps a list for many steps.
+ * keeps a list for many steps. A skin sized to survive several steps of a
+ * fast flow costs more than it saves: every loop pays for the longer list,
+ * and a build at radius R > cell size looks at more cells.
  */
 #include "mf_neighbours.h"
 
@@ -31,6 +33,11 @@
 #include "mf_pairs.h"
 
 #define SKIN_FACTOR 2.5
+/* The largest request of radius at most this share of its class's gets a
+ * list of its own, made in the same pass (mf_nlist_build_pair): the
+ * gradient at 2.1 l0 beside a Laplacian at 3.1 l0 visits half the pairs.
+ * Smaller requests of the class use it too while it holds their pairs. */
+#define SUB_SHARE 0.8
 /* A list serves radius r while r + 2d <= R (1 - MARGIN): rounding of the
  * distances cannot matter at that margin. */
 #define MARGIN 1e-9
@@ -40,13 +47,17 @@ typedef struct nb_class {
     double radius;      /* largest radius of its requests */
     double skin;        /* of the next build */
     double list_radius; /* of the current list; 0: none */
-    double d_pass;      /* largest displacement the current list survived */
+    double d_first;     /* displacement at the first order point after the build; -1: none yet */
+    double need;        /* the skin last asked for */
     unsigned long epoch; /* order point the list is in the order of */
     const mf_particles *store;
     mf_grid grid;
     mf_nlist list;
     int64_t *id0;       /* ids at the build, in the grid's (cell) order */
     size_t cap_id;
+    mf_nlist sub;       /* the sub-list (see SUB_SHARE) */
+    double sub_radius;  /* the request it serves; 0: none at the last build */
+    double sub_list_radius; /* sub_radius + the skin of the build */
 } nb_class;
 
 typedef struct nb_handle {
@@ -93,6 +104,7 @@ void mf_neighbours_destroy(mf_neighbours *nb)
     for (int c = 0; c < nb->nclasses; c++) {
         mf_grid_free(&nb->cls[c].grid);
         mf_nlist_free(&nb->cls[c].list);
+        mf_nlist_free(&nb->cls[c].sub);
         free(nb->cls[c].id0);
     }
     mf_grid_free(&nb->points);
@@ -136,7 +148,18 @@ static int class_of(mf_neighbours *nb, double cell, int *out)
     c->skin = nb->skin_start * cell;
     mf_grid_init(&c->grid);
     mf_nlist_init(&c->list);
+    mf_nlist_init(&c->sub);
     *out = nb->nclasses++;
+    return 0;
+}
+
+/* h joins the class of this cell. */
+static int join_class(mf_neighbours *nb, nb_handle *h, double cell)
+{
+    MF_CALL(class_of(nb, cell, &h->cls));
+    nb_class *c = &nb->cls[h->cls];
+    if (h->radius > c->radius)
+        c->radius = h->radius;
     return 0;
 }
 
@@ -162,11 +185,8 @@ int mf_neighbours_request(mf_neighbours *nb, double radius, double cell, int *ha
     h->radius = radius;
     h->cell = cell;
     h->cls = -1;
-    if (cell > 0) {
-        MF_CALL(class_of(nb, cell, &h->cls));
-        if (radius > nb->cls[h->cls].radius)
-            nb->cls[h->cls].radius = radius;
-    }
+    if (cell > 0)
+        MF_CALL(join_class(nb, h, cell));
     *handle = nb->nhandles++;
     return 0;
 }
@@ -178,15 +198,9 @@ static int resolve(mf_neighbours *nb, nb_handle *h)
         return 0;
     double best = INFINITY;
     for (int c = 0; c < nb->nclasses; c++)
-        if (nb->cls[c].cell >= h->radius && nb->cls[c].cell < best) {
+        if (nb->cls[c].cell >= h->radius && nb->cls[c].cell < best)
             best = nb->cls[c].cell;
-            h->cls = c;
-        }
-    if (h->cls < 0)
-        MF_CALL(class_of(nb, h->radius, &h->cls));
-    nb_class *c = &nb->cls[h->cls];
-    if (h->radius > c->radius)
-        c->radius = h->radius;
+    MF_CALL(join_class(nb, h, isfinite(best) ? best : h->radius));
     return 0;
 }
 
@@ -229,7 +243,18 @@ static int build(mf_neighbours *nb, nb_class *c, const mf_particles *p)
     const double R = c->radius + c->skin;
     c->list_radius = 0;
     MF_CALL(mf_grid_build_reach(&c->grid, p, c->cell, R > c->cell ? 2 : 1));
-    MF_CALL(mf_nlist_build(&c->list, &c->grid, p, R));
+    const int self = (int)(c - nb->cls);
+    c->sub_radius = 0;
+    for (int k = 0; k < nb->nhandles; k++) {
+        const double r = nb->handle[k].radius;
+        if (nb->handle[k].cls == self && r <= SUB_SHARE * c->radius && r > c->sub_radius)
+            c->sub_radius = r;
+    }
+    c->sub_list_radius = c->sub_radius > 0 ? c->sub_radius + c->skin : 0;
+    if (c->sub_radius > 0)
+        MF_CALL(mf_nlist_build_pair(&c->list, &c->sub, &c->grid, p, R, c->sub_list_radius));
+    else
+        MF_CALL(mf_nlist_build(&c->list, &c->grid, p, R));
     const size_t np = p->n;
     if (np > c->cap_id) {
         size_t cap = np + np / 8 + 16;
@@ -243,41 +268,50 @@ static int build(mf_neighbours *nb, nb_class *c, const mf_particles *p)
         c->id0[k] = p->id[c->grid.order[k]];
     c->store = p;
     c->list_radius = R;
-    c->d_pass = 0;
+    c->d_first = -1;
     c->epoch = nb->epoch;
     nb->stats.builds++;
     nb->stats.entries = np ? (double)c->list.start[np] / (double)np : 0.0;
     return 0;
 }
 
-/* The lists of class c at the current positions, good for radius r. */
-static int refresh(mf_neighbours *nb, nb_class *c, const mf_particles *p, double r)
+/* The lists of class c at the current positions, good for radius r; *dmax:
+ * the largest displacement since their build. */
+static int refresh(mf_neighbours *nb, nb_class *c, const mf_particles *p, double r,
+                   double *dmax)
 {
     const double t0 = now();
     int rc = 0;
     nb->stats.checks++;
     const double d = displacement(c, p);
     const bool same = !isnan(d);
-    if (same && r + 2 * d <= c->list_radius * (1 - MARGIN) &&
-        c->list_radius >= c->radius) {
-        if (d > c->d_pass)
-            c->d_pass = d;
+    const bool kept = same && r + 2 * d <= c->list_radius * (1 - MARGIN) &&
+                      c->list_radius >= c->radius;
+    if (kept) {
         if (c->epoch != nb->epoch) { /* an order point since: the order of now */
-            rc = mf_grid_keys(p, c->cell, c->grid.sort_key);
+            if (c->d_first < 0)
+                c->d_first = d;
+            bool packed = false;
+            rc = mf_grid_keys(p, c->cell, c->grid.sort_key, &packed);
             if (rc == 0) {
-                mf_nlist_sort(&c->list, c->grid.sort_key);
+                mf_nlist_sort(&c->list, c->grid.sort_key, packed);
+                if (c->sub_radius > 0)
+                    mf_nlist_sort(&c->sub, c->grid.sort_key, packed);
                 c->epoch = nb->epoch;
                 nb->stats.sorts++;
             }
         }
     } else {
-        if (same) { /* moved too far for the skin: fit it to what was needed */
-            double need = SKIN_FACTOR * (c->d_pass > 0 ? c->d_pass : d);
-            double lo = nb->skin_min * c->cell, hi = nb->skin_max * c->cell;
-            c->skin = need < lo ? lo : need > hi ? hi : need;
+        if (same) { /* moved too far for the skin: fit it to what is needed */
+            const double d1 = c->d_first >= 0 ? c->d_first : d;
+            /* Shrink slowly: one small step must not undo a larger need. */
+            c->need = fmax(SKIN_FACTOR * d1, 0.5 * c->need);
+            const double lo = nb->skin_min * c->cell, hi = nb->skin_max * c->cell;
+            c->skin = c->need < lo ? lo : c->need > hi ? hi : c->need;
         }
         rc = build(nb, c, p);
     }
+    *dmax = kept ? d : 0.0; /* a fresh build: nothing has moved */
     nb->stats.seconds += now() - t0;
     return rc == 0 ? 0 : mf_error_trace(rc, __FILE__, __LINE__, __func__);
 }
@@ -299,8 +333,14 @@ int mf_neighbours_pairs(mf_neighbours *nb, const mf_particles *p, int handle, mf
     nb_handle *h;
     nb_class *c;
     MF_CALL(handle_class(nb, handle, &h, &c));
-    MF_CALL(refresh(nb, c, p, h->radius));
-    *out = mf_pairs_of_list(p, &c->list, h->radius);
+    double d = 0;
+    MF_CALL(refresh(nb, c, p, h->radius, &d));
+    /* The sub-list while it holds the pairs, else the class's: same order. */
+    if (h->radius <= c->sub_radius &&
+        h->radius + 2 * d <= c->sub_list_radius * (1 - MARGIN))
+        *out = mf_pairs_of_list(p, &c->sub, h->radius);
+    else
+        *out = mf_pairs_of_list(p, &c->list, h->radius);
     return 0;
 }
 
@@ -348,7 +388,7 @@ size_t mf_neighbours_memory(const mf_neighbours *nb)
     size_t bytes = mf_grid_memory(&nb->points);
     for (int c = 0; c < nb->nclasses; c++)
         bytes += mf_grid_memory(&nb->cls[c].grid) + mf_nlist_memory(&nb->cls[c].list) +
-                 nb->cls[c].cap_id * sizeof(int64_t);
+                 mf_nlist_memory(&nb->cls[c].sub) + nb->cls[c].cap_id * sizeof(int64_t);
     return bytes;
 }
 

@@ -114,6 +114,7 @@ typedef int64_t vec2i __attribute__((vector_size(2 * sizeof(int64_t))));
 typedef struct {
     const double *sx, *sy, *sz; /* positions in cell order */
     double r2;
+    double r2s;                 /* the sub-list's (mf_nlist_build_pair) */
 } pair_test;
 
 static inline vec2d load2(const double *x)
@@ -128,8 +129,8 @@ static inline vec2d splat2(double x)
     return (vec2d){x, x};
 }
 
-/* Candidates m, m + 1 closer than the radius: lanes -1 (in) or 0 (out). */
-KERNEL vec2i within2(const pair_test *t, size_t m, const double xi[3], int dim)
+/* Squared distances of candidates m, m + 1. */
+KERNEL vec2d distance2_2(const pair_test *t, size_t m, const double xi[3], int dim)
 {
     vec2d dx = load2(t->sx + m) - splat2(xi[0]);
     vec2d dy = load2(t->sy + m) - splat2(xi[1]);
@@ -138,7 +139,13 @@ KERNEL vec2i within2(const pair_test *t, size_t m, const double xi[3], int dim)
         vec2d dz = load2(t->sz + m) - splat2(xi[2]);
         d2 += dz * dz;
     }
-    return d2 < splat2(t->r2);
+    return d2;
+}
+
+/* Candidates m, m + 1 closer than the radius: lanes -1 (in) or 0 (out). */
+KERNEL vec2i within2(const pair_test *t, size_t m, const double xi[3], int dim, double r2)
+{
+    return distance2_2(t, m, xi, dim) < splat2(r2);
 }
 
 /* The two lanes of a test as bits 0 and 1. */
@@ -151,7 +158,7 @@ static inline unsigned lane_bits(vec2i h)
 #endif
 }
 
-KERNEL bool within1(const pair_test *t, size_t m, const double xi[3], int dim)
+KERNEL double distance2_1(const pair_test *t, size_t m, const double xi[3], int dim)
 {
     double dx = t->sx[m] - xi[0], dy = t->sy[m] - xi[1];
     double d2 = dx * dx + dy * dy;
@@ -159,7 +166,12 @@ KERNEL bool within1(const pair_test *t, size_t m, const double xi[3], int dim)
         double dz = t->sz[m] - xi[2];
         d2 += dz * dz;
     }
-    return d2 < t->r2;
+    return d2;
+}
+
+KERNEL bool within1(const pair_test *t, size_t m, const double xi[3], int dim, double r2)
+{
+    return distance2_1(t, m, xi, dim) < r2;
 }
 
 /* Candidate bits: a particle's bits start at a word, and each row at an even
@@ -180,21 +192,27 @@ static size_t words_per_particle(const uint32_t *rows, int nrows)
 }
 
 /* Test every candidate of sorted particle k (position xi); with keep_bits,
- * store the outcomes as bits in words. Returns the count of hits, the
- * particle itself included (its distance 0 is < r2). dim and keep_bits are
- * literals at the call sites, so each combination compiles to its own loop. */
+ * store the outcomes as bits in words; with sub, count in *shits those
+ * closer than the sub-list's radius too. Returns the count of hits, the
+ * particle itself included (its distance 0 is < r2). dim, keep_bits and
+ * sub are literals at the call sites, so each combination compiles to its
+ * own loop. */
 KERNEL size_t test_candidates(const pair_test *t, const uint32_t *rows, int nrows,
-                              const double xi[3], int dim, bool keep_bits, uint64_t *words)
+                              const double xi[3], int dim, bool keep_bits, uint64_t *words,
+                              bool sub, size_t *shits)
 {
-    vec2i hits = {0, 0};
+    vec2i hits = {0, 0}, sh = {0, 0};
     uint64_t acc = 0;
     unsigned bit = 0;
     for (int r = 0; r < nrows; r++) {
         size_t m = rows[2 * r];
         const size_t b = rows[2 * r + 1];
         for (; m + 2 <= b; m += 2) {
-            vec2i h = within2(t, m, xi, dim);
+            const vec2d d2 = distance2_2(t, m, xi, dim);
+            const vec2i h = d2 < splat2(t->r2);
             hits -= h;
+            if (sub)
+                sh -= d2 < splat2(t->r2s);
             if (keep_bits) {
                 acc |= (uint64_t)lane_bits(h) << bit;
                 bit += 2;
@@ -206,8 +224,11 @@ KERNEL size_t test_candidates(const pair_test *t, const uint32_t *rows, int nrow
             }
         }
         if (m < b) {
-            uint64_t h = within1(t, m, xi, dim);
+            const double d2 = distance2_1(t, m, xi, dim);
+            const uint64_t h = d2 < t->r2;
             hits[0] += (int64_t)h;
+            if (sub)
+                sh[0] += d2 < t->r2s;
             if (keep_bits) {
                 acc |= h << bit;
                 bit += 2;
@@ -221,15 +242,19 @@ KERNEL size_t test_candidates(const pair_test *t, const uint32_t *rows, int nrow
     }
     if (keep_bits && bit)
         *words = acc;
+    if (sub)
+        *shits = (size_t)(sh[0] + sh[1]);
     return (size_t)(hits[0] + hits[1]);
 }
 
-/* Append the particle indices of the set bits (other than k itself). */
+/* Append the particle indices of the set bits (other than k itself); with
+ * sub (a literal), those closer than the sub-list's radius to sout too. */
 KERNEL size_t decode_bits(const uint64_t *words, size_t nwords, const uint32_t *rows,
                           const size_t row_bit[MAX_ROWS + 1], const uint32_t *order, size_t k,
-                          uint32_t *out)
+                          uint32_t *out, bool sub, const pair_test *t, const double xi[3],
+                          int dim, uint32_t *sout)
 {
-    size_t w = 0;
+    size_t w = 0, ws = 0;
     int r = 0;
     for (size_t wi = 0; wi < nwords; wi++) {
         uint64_t word = words[wi];
@@ -239,30 +264,33 @@ KERNEL size_t decode_bits(const uint64_t *words, size_t nwords, const uint32_t *
             while (bit >= row_bit[r + 1])
                 r++;
             size_t m = rows[2 * r] + (bit - row_bit[r]);
-            if (m != k)
+            if (m != k) {
                 out[w++] = order[m];
+                if (sub && distance2_1(t, m, xi, dim) < t->r2s)
+                    sout[ws++] = order[m];
+            }
         }
     }
     return w;
 }
 
-/* Fallback fill without bits: repeat the distance test. */
+/* Fallback fill without bits: repeat the distance test (radius^2 r2). */
 KERNEL size_t retest_candidates(const pair_test *t, const uint32_t *rows, int nrows,
                                 const uint32_t *order, size_t k, const double xi[3], int dim,
-                                uint32_t *out)
+                                double r2, uint32_t *out)
 {
     size_t w = 0;
     for (int r = 0; r < nrows; r++) {
         size_t m = rows[2 * r];
         const size_t b = rows[2 * r + 1];
         for (; m + 2 <= b; m += 2) {
-            vec2i h = within2(t, m, xi, dim);
+            vec2i h = within2(t, m, xi, dim, r2);
             if (h[0] && m != k)
                 out[w++] = order[m];
             if (h[1] && m + 1 != k)
                 out[w++] = order[m + 1];
         }
-        if (m < b && within1(t, m, xi, dim) && m != k)
+        if (m < b && within1(t, m, xi, dim, r2) && m != k)
             out[w++] = order[m];
     }
     return w;
@@ -308,6 +336,13 @@ static inline void bounds_of_cell(const mf_grid *g, size_t c, int nrows, cell_bo
     }
 }
 
+/* floor(t) of a finite t (no libm call). */
+static inline int64_t floor_int(double t)
+{
+    int64_t a = (int64_t)t;
+    return (double)a > t ? a - 1 : a;
+}
+
 /* Offsets (cells from the particle's own) of the first and last cell that
  * the interval [x - R, x + R] meets on one axis, within [-reach, reach]. The
  * radius is taken a hair larger so that rounding cannot drop a cell. */
@@ -315,8 +350,8 @@ static inline void axis_span(double x, double origin, double inv_width, double r
                              int64_t own, int reach, int *lo, int *hi)
 {
     const double r = radius * (1.0 + 1e-12);
-    int64_t a = (int64_t)floor((x - r - origin) * inv_width) - own;
-    int64_t b = (int64_t)floor((x + r - origin) * inv_width) - own;
+    int64_t a = floor_int((x - r - origin) * inv_width) - own;
+    int64_t b = floor_int((x + r - origin) * inv_width) - own;
     *lo = a < -reach ? -reach : a > 0 ? 0 : (int)a;
     *hi = b > reach ? reach : b < 0 ? 0 : (int)b;
 }
@@ -380,8 +415,10 @@ KERNEL void plan_cell(const list_build *lb, size_t c, int dim)
     }
 }
 
-/* Pass 1: start[i + 1] = number of neighbours of i; bits if kept. */
-KERNEL void count_cell(const list_build *lb, size_t c, int dim, bool keep_bits, uint32_t *start)
+/* Pass 1: start[i + 1] = number of neighbours of i; bits if kept; with sub
+ * the same for the sub-list into sstart. */
+KERNEL void count_cell(const list_build *lb, size_t c, int dim, bool keep_bits, bool sub,
+                       uint32_t *start, uint32_t *sstart)
 {
     const mf_grid *g = lb->g;
     cell_bounds cb;
@@ -391,15 +428,19 @@ KERNEL void count_cell(const list_build *lb, size_t c, int dim, bool keep_bits, 
         double xi[3];
         load_position(&lb->t, k, xi);
         int n = particle_rows(g, &cb, xi, lb->radius, lb->inv_width, dim, rows);
+        size_t shits = 0;
         size_t hits = test_candidates(&lb->t, rows, n, xi, dim, keep_bits,
-                                      keep_bits ? lb->bits + lb->word[k] : NULL);
+                                      keep_bits ? lb->bits + lb->word[k] : NULL, sub, &shits);
         start[g->order[k] + 1] = (uint32_t)(hits - 1); /* minus the particle itself */
+        if (sub)
+            sstart[g->order[k] + 1] = (uint32_t)(shits - 1);
     }
 }
 
-/* Pass 2: j's at the offsets of pass 1, from the bits or by testing again. */
+/* Pass 2: j's at the offsets of pass 1, from the bits or by testing again
+ * (and the sub-list's, when sstart is not NULL). */
 KERNEL void fill_cell(const list_build *lb, size_t c, int dim, const uint32_t *start,
-                      uint32_t *jlist)
+                      uint32_t *jlist, const uint32_t *sstart, uint32_t *sjlist)
 {
     const mf_grid *g = lb->g;
     cell_bounds cb;
@@ -409,14 +450,23 @@ KERNEL void fill_cell(const list_build *lb, size_t c, int dim, const uint32_t *s
         double xi[3];
         load_position(&lb->t, k, xi);
         int n = particle_rows(g, &cb, xi, lb->radius, lb->inv_width, dim, rows);
-        uint32_t *out = jlist + start[g->order[k]];
+        const uint32_t i = g->order[k];
+        uint32_t *out = jlist + start[i];
         if (lb->word) {
             size_t row_bit[MAX_ROWS + 1];
             row_bit_offsets(rows, n, row_bit);
-            decode_bits(lb->bits + lb->word[k], lb->word[k + 1] - lb->word[k], rows, row_bit,
-                        g->order, k, out);
+            const size_t nw = lb->word[k + 1] - lb->word[k];
+            if (sstart)
+                decode_bits(lb->bits + lb->word[k], nw, rows, row_bit, g->order, k, out, true,
+                            &lb->t, xi, dim, sjlist + sstart[i]);
+            else
+                decode_bits(lb->bits + lb->word[k], nw, rows, row_bit, g->order, k, out, false,
+                            &lb->t, xi, dim, NULL);
         } else {
-            retest_candidates(&lb->t, rows, n, g->order, k, xi, dim, out);
+            retest_candidates(&lb->t, rows, n, g->order, k, xi, dim, lb->t.r2, out);
+            if (sstart)
+                retest_candidates(&lb->t, rows, n, g->order, k, xi, dim, lb->t.r2s,
+                                  sjlist + sstart[i]);
         }
     }
 }
@@ -434,35 +484,53 @@ static void plan_pass(const list_build *lb)
     }
 }
 
-static void count_pass(const list_build *lb, uint32_t *start)
+/* One cell of pass 1 with literal arguments: the compiler specialises the
+ * kernels for each combination. */
+static inline void count_cell_as(const list_build *lb, size_t c, int dim, bool keep_bits,
+                                 bool sub, uint32_t *start, uint32_t *sstart)
 {
-    const size_t ncells = lb->g->ncells;
-    const int dim = lb->g->dim;
-    const bool keep_bits = lb->word != NULL;
-#pragma omp parallel for schedule(dynamic, 32)
-    for (size_t c = 0; c < ncells; c++) {
-        /* Literals let the compiler specialise the kernels. */
-        if (dim == 3 && keep_bits)
-            count_cell(lb, c, 3, true, start);
-        else if (dim == 3)
-            count_cell(lb, c, 3, false, start);
+    if (dim == 3) {
+        if (keep_bits && sub)
+            count_cell(lb, c, 3, true, true, start, sstart);
         else if (keep_bits)
-            count_cell(lb, c, 2, true, start);
+            count_cell(lb, c, 3, true, false, start, sstart);
+        else if (sub)
+            count_cell(lb, c, 3, false, true, start, sstart);
         else
-            count_cell(lb, c, 2, false, start);
+            count_cell(lb, c, 3, false, false, start, sstart);
+    } else {
+        if (keep_bits && sub)
+            count_cell(lb, c, 2, true, true, start, sstart);
+        else if (keep_bits)
+            count_cell(lb, c, 2, true, false, start, sstart);
+        else if (sub)
+            count_cell(lb, c, 2, false, true, start, sstart);
+        else
+            count_cell(lb, c, 2, false, false, start, sstart);
     }
 }
 
-static void fill_pass(const list_build *lb, const uint32_t *start, uint32_t *jlist)
+static void count_pass(const list_build *lb, uint32_t *start, uint32_t *sstart)
+{
+    const size_t ncells = lb->g->ncells;
+    const int dim = lb->g->dim;
+    const bool keep_bits = lb->word != NULL, sub = sstart != NULL;
+#pragma omp parallel for schedule(dynamic, 32)
+    for (size_t c = 0; c < ncells; c++)
+        count_cell_as(lb, c, dim, keep_bits, sub, start, sstart);
+}
+
+static void fill_pass(const list_build *lb, const uint32_t *start, uint32_t *jlist,
+                      const uint32_t *sstart, uint32_t *sjlist)
 {
     const size_t ncells = lb->g->ncells;
     const int dim = lb->g->dim;
 #pragma omp parallel for schedule(dynamic, 32)
     for (size_t c = 0; c < ncells; c++) {
         if (dim == 3)
-            fill_cell(lb, c, 3, start, jlist);
+            fill_cell(lb, c, 3, start, jlist, sstart, sjlist);
         else
-            fill_cell(lb, c, 2, start, jlist);
+            fill_cell(lb, c, 2, start, jlist, sstart, sjlist);
     }
 }
 
@@ -504,13 +572,23 @@ static int plan_bits(mf_nlist *nl, list_build *lb)
 
 int mf_nlist_build(mf_nlist *nl, const mf_grid *g, const mf_particles *p, double radius)
 {
-    if (!nl || !g || !p)
+    return mf_nlist_build_pair(nl, NULL, g, p, radius, 0.0);
+}
+
+int mf_nlist_build_pair(mf_nlist *nl, mf_nlist *sub, const mf_grid *g, const mf_particles *p,
+                        double radius, double sub_radius)
+{
+    if (!nl || !g || !p || nl == sub)
         return MF_ERROR(MF_ERR_INPUT, "mf_nlist_build: NULL list, grid or particles");
     if (!(radius * radius > 0.0) || radius > g->reach * g->cell_size)
         return MF_ERROR(MF_ERR_INPUT,
                         "neighbour radius %g must be positive and at most %d times the cell "
                         "size %g",
                         radius, g->reach, g->cell_size);
+    if (sub && (!(sub_radius * sub_radius > 0.0) || sub_radius > radius))
+        return MF_ERROR(MF_ERR_INPUT,
+                        "sub-list radius %g must be positive and at most the list radius %g",
+                        sub_radius, radius);
     if (g->np != p->n || g->dim != p->dim)
         return MF_ERROR(MF_ERR_INPUT,
                         "grid is stale: built for %zu particles in %d-D, now %zu in %d-D "
@@ -520,50 +598,79 @@ int mf_nlist_build(mf_nlist *nl, const mf_grid *g, const mf_particles *p, double
     MF_CALL(ensure_start(nl, n));
     nl->n = 0;
     nl->radius = radius;
+    if (sub) {
+        MF_CALL(ensure_start(sub, n));
+        sub->n = 0;
+        sub->radius = sub_radius;
+    }
 
     list_build lb = {
         .g = g,
-        .t = {g->spos, g->spos + n, g->spos + 2 * n, radius * radius},
+        .t = {g->spos, g->spos + n, g->spos + 2 * n, radius * radius,
+              sub ? sub_radius * sub_radius : 0.0},
         .radius = radius,
         .inv_width = 1.0 / binning_width(g->cell_size),
         .nrows = rows_per_cell(g->dim, g->reach),
     };
     MF_CALL(plan_bits(nl, &lb));
-    count_pass(&lb, nl->start);
+    count_pass(&lb, nl->start, sub ? sub->start : NULL);
     MF_CALL(counts_to_offsets(nl->start, n));
     MF_CALL(ensure_entries(nl, nl->start[n] > 0 ? nl->start[n] : 1));
-    fill_pass(&lb, nl->start, nl->j);
+    if (sub) {
+        MF_CALL(counts_to_offsets(sub->start, n));
+        MF_CALL(ensure_entries(sub, sub->start[n] > 0 ? sub->start[n] : 1));
+    }
+    fill_pass(&lb, nl->start, nl->j, sub ? sub->start : NULL, sub ? sub->j : NULL);
     nl->n = n;
+    if (sub)
+        sub->n = n;
     return 0;
 }
 
 /* ---- order ----------------------------------------------------------------- */
 
-static inline bool before(const uint64_t *keys, uint32_t a, uint32_t b)
+/* Does (ka, a) come before (kb, b)? By the keys alone when they hold the
+ * index (packed, a literal at the call sites). */
+KERNEL bool before(uint64_t ka, uint32_t a, uint64_t kb, uint32_t b, bool packed)
 {
-    return keys[a] < keys[b] || (keys[a] == keys[b] && a < b);
+    return packed ? ka < kb : ka < kb || (ka == kb && a < b);
 }
 
-void mf_nlist_sort(mf_nlist *nl, const uint64_t *keys)
+/* Insertion sort of one list; in order, it costs a load and a compare an
+ * entry. */
+KERNEL void sort_one(uint32_t *e, uint32_t m, const uint64_t *keys, bool packed)
+{
+    if (m < 2)
+        return;
+    uint64_t kprev = keys[e[0]];
+    for (uint32_t a = 1; a < m; a++) {
+        const uint32_t v = e[a];
+        const uint64_t kv = keys[v];
+        if (!before(kv, v, kprev, e[a - 1], packed)) {
+            kprev = kv;
+            continue;
+        }
+        uint32_t b = a;
+        do {
+            e[b] = e[b - 1];
+            b--;
+        } while (b > 0 && before(kv, v, keys[e[b - 1]], e[b - 1], packed));
+        e[b] = v;
+        kprev = keys[e[a]];
+    }
+}
+
+void mf_nlist_sort(mf_nlist *nl, const uint64_t *keys, bool packed)
 {
     const long n = (long)nl->n;
     const uint32_t *start = nl->start;
     uint32_t *jl = nl->j;
 #pragma omp parallel for schedule(dynamic, 256)
     for (long i = 0; i < n; i++) {
-        uint32_t *e = jl + start[i];
-        const uint32_t m = start[i + 1] - start[i];
-        for (uint32_t a = 1; a < m; a++) {
-            const uint32_t v = e[a];
-            if (!before(keys, v, e[a - 1]))
-                continue;
-            uint32_t b = a;
-            do {
-                e[b] = e[b - 1];
-                b--;
-            } while (b > 0 && before(keys, v, e[b - 1]));
-            e[b] = v;
-        }
+        if (packed)
+            sort_one(jl + start[i], start[i + 1] - start[i], keys, true);
+        else
+            sort_one(jl + start[i], start[i + 1] - start[i], keys, false);
     }
 }
 

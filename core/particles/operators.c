@@ -80,14 +80,28 @@ static inline bool grad_pair(void *acc, const void *ctx, const mf_pair *pr)
     return true;
 }
 
+/* Pairs a row gathers for its two passes; a row with more runs both passes
+ * over the list. */
+#define GATHER 96
+
 static void grad_row(const void *ctx, size_t i)
 {
     const grad_ctx *c = ctx;
     const mf_gradient_opts *o = c->o;
     grad_acc a = {o->f[i], {0.0, 0.0, 0.0}};
-    if (o->use_min && !(o->own_reference && o->own_reference[i]))
-        mf_pairs_row(c->v, i, c->jmask, min_pair, c, &a.fhat);
-    mf_pairs_row(c->v, i, c->jmask, grad_pair, c, &a);
+    const bool use_min = o->use_min && !(o->own_reference && o->own_reference[i]);
+    mf_pair buf[GATHER];
+    const size_t n = use_min ? mf_pairs_gather(c->v, i, c->jmask, buf, GATHER) : GATHER + 1;
+    if (n <= GATHER) {
+        for (size_t k = 0; k < n; k++)
+            min_pair(&a.fhat, c, &buf[k]);
+        for (size_t k = 0; k < n; k++)
+            grad_pair(&a, c, &buf[k]);
+    } else {
+        if (use_min)
+            mf_pairs_row(c->v, i, c->jmask, min_pair, c, &a.fhat);
+        mf_pairs_row(c->v, i, c->jmask, grad_pair, c, &a);
+    }
     c->out[3 * i + 0] = c->coef * a.g[0];
     c->out[3 * i + 1] = c->coef * a.g[1];
     c->out[3 * i + 2] = c->coef * a.g[2];
@@ -137,8 +151,13 @@ static inline bool lap_pair(void *acc, const void *ctx, const mf_pair *pr, int n
     if (mu)
         cij = c->mu_mask[j] ? mf_mu_pair(c->mu[i], c->mu[j], c->mu_average) : c->mu[i];
     const double *f = c->f;
-    for (int q = 0; q < ncomp; q++)
-        a[q] += mf_laplacian_term(cij, f[ncomp * j + q] - f[ncomp * i + q], w);
+    if (ncomp == 3) { /* written out: the sums stay in registers */
+        a[0] += mf_laplacian_term(cij, f[3 * j] - f[3 * i], w);
+        a[1] += mf_laplacian_term(cij, f[3 * j + 1] - f[3 * i + 1], w);
+        a[2] += mf_laplacian_term(cij, f[3 * j + 2] - f[3 * i + 2], w);
+    } else {
+        a[0] += mf_laplacian_term(cij, f[j] - f[i], w);
+    }
     return true;
 }
 
@@ -282,18 +301,20 @@ static inline bool coll_pair(void *acc, const void *ctx, const mf_pair *pr)
     double *vi = acc;
     if (pr->r2 <= 0)
         return true;
-    const double len = pr->len, *vj = c->vel + 3 * pr->j;
+    const double len = pr->len, *vj = c->vel + 3 * pr->j, *r = pr->r;
     double approach = 0;
-    for (int q = 0; q < 3; q++)
-        approach += (vi[q] - vj[q]) * pr->r[q] / len;
+    approach += (vi[0] - vj[0]) * r[0] / len;
+    approach += (vi[1] - vj[1]) * r[1] / len;
+    approach += (vi[2] - vj[2]) * r[2] / len;
     if (approach <= 0)
         return true;
     const size_t i = pr->i, j = pr->j;
     const double share = !c->movable[j] ? 1.0
                          : c->rho       ? c->rho[j] / (c->rho[i] + c->rho[j])
                                         : 0.5;
-    for (int q = 0; q < 3; q++)
-        vi[q] -= share * (1 + c->e) * approach * pr->r[q] / len;
+    vi[0] -= share * (1 + c->e) * approach * r[0] / len;
+    vi[1] -= share * (1 + c->e) * approach * r[1] / len;
+    vi[2] -= share * (1 + c->e) * approach * r[2] / len;
     return true;
 }
 

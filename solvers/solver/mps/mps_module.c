@@ -183,6 +183,13 @@ static void mps_report(void *data, const mf_sim *sim, mf_log *log)
                   "average\n",
                   d->ppe_rows,
                   (double)sim->pressure_iterations / (d->solves > 0 ? (double)d->solves : 1.0));
+    mf_neighbours_stats nb;
+    mf_neighbours_get_stats(d->nb, &nb);
+    mf_log_printf(log, MF_LOG_QUIET,
+                  "MPS neighbours: %ld list builds and %ld re-sorts in %ld steps, %.1f list "
+                  "entries a particle, %.1f MB\n",
+                  nb.builds, nb.sorts, d->attempts, nb.entries,
+                  mf_neighbours_memory(d->nb) / 1048576.0);
     mps_viscosity_report(d->visc, sim, log);
 }
 

@@ -175,6 +175,12 @@ static bool ppe_row(const void *ctx, size_t i, size_t r)
     return true;
 }
 
+static size_t ppe_count(const void *ctx, size_t i)
+{
+    const ppe_ctx *c = ctx;
+    return mf_pairs_row_count(&c->v, i, c->d->not_dummy, NULL, c, c->rows.col_of);
+}
+
 /* Between the count and the fill: room for the entries. */
 static int ppe_sized(void *ctx, size_t nnz)
 {
@@ -222,8 +228,8 @@ int mps_assemble_ppe(mps_data *d, const mf_sim *sim, double dt)
     c.re = c.v.radius;
     size_t failed = SIZE_MAX;
     if (rc == 0)
-        rc = mf_pairs_assemble(&c.v, d->not_dummy, NULL, &c, &c.rows, nrows, ppe_sized, &c,
-                               ppe_row, &failed);
+        rc = mf_pairs_assemble(&c.v, d->row, A->rowptr, nrows, ppe_count, ppe_sized, ppe_row, &c,
+                               &failed);
     if (rc == 0 && failed != SIZE_MAX) {
         /* n* counts dummy particles, the Laplacian does not: a fluid
          * particle with only dummies within re is inside a wall, and its

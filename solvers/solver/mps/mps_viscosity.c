@@ -168,6 +168,12 @@ static bool visc_row(const void *ctx, size_t i, size_t r)
     return true;
 }
 
+static size_t visc_count(const void *ctx, size_t i)
+{
+    const visc_ctx *c = ctx;
+    return mf_pairs_row_count(&c->v, i, NULL, visc_takes_part, c, c->rows.col_of);
+}
+
 static int visc_sized(void *ctx, size_t nnz)
 {
     visc_ctx *c = ctx;
@@ -196,8 +202,8 @@ static int assemble(mps_data *d, const mf_sim *sim, double dt, double *dirichlet
     MF_CALL(mps_pairs(d, sim, d->h_lap, &c.v));
     c.re = c.v.radius;
     size_t failed;
-    MF_CALL(mf_pairs_assemble(&c.v, NULL, visc_takes_part, &c, &c.rows, A->nrows, visc_sized, &c,
-                              visc_row, &failed));
+    MF_CALL(mf_pairs_assemble(&c.v, v->row, A->rowptr, A->nrows, visc_count, visc_sized, visc_row,
+                              &c, &failed));
     return 0;
 }
 
