@@ -22,6 +22,8 @@
 
 /* ---- grid: memory ----------------------------------------------------- */
 
+static void free_sort_buffers(mf_grid *g);
+
 void mf_grid_init(mf_grid *g)
 {
     memset(g, 0, sizeof *g);
@@ -38,42 +40,64 @@ void mf_grid_free(mf_grid *g)
     free(g->hash_key);
     free(g->hash_cell);
     free(g->spos);
+    free_sort_buffers(g);
+    mf_grid_init(g);
+}
+
+static void free_sort_buffers(mf_grid *g)
+{
     free(g->sort_key);
     free(g->sort_idx);
-    mf_grid_init(g);
+    g->sort_key = NULL;
+    g->sort_idx = NULL;
+    g->alloc_sort = 0;
 }
 
 static void free_np_buffers(mf_grid *g)
 {
     free(g->order);
     free(g->spos);
-    free(g->sort_key);
-    free(g->sort_idx);
     g->order = NULL;
     g->spos = NULL;
-    g->sort_key = NULL;
-    g->sort_idx = NULL;
     g->alloc_np = 0;
+    free_sort_buffers(g);
 }
 
+/* order and spos, kept with the grid; the radix sort's double buffers,
+ * which mf_grid_release_scratch may free between builds. */
 static int ensure_np_buffers(mf_grid *g, size_t np)
 {
-    if (g->order && !needs_realloc(g->alloc_np, np))
-        return 0;
-    size_t cap = with_headroom(np);
-    free_np_buffers(g);
-    if (cap > SIZE_MAX / 3 / sizeof(double))
-        return MF_ERROR(MF_ERR_MEMORY, "neighbour grid for %zu particles is too large", np);
     int rc = 0;
-    if ((rc = replace_buffer((void **)&g->order, cap, sizeof(size_t), "particle order")) ||
-        (rc = replace_buffer((void **)&g->spos, 3 * cap, sizeof(double), "sorted positions")) ||
-        (rc = replace_buffer((void **)&g->sort_key, 2 * cap, sizeof(uint64_t), "sort keys")) ||
-        (rc = replace_buffer((void **)&g->sort_idx, 2 * cap, sizeof(uint32_t), "sort indices"))) {
+    if (!g->order || needs_realloc(g->alloc_np, np)) {
+        size_t cap = with_headroom(np);
         free_np_buffers(g);
-        return mf_error_trace(rc, __FILE__, __LINE__, __func__);
+        if (cap > SIZE_MAX / 3 / sizeof(double))
+            return MF_ERROR(MF_ERR_MEMORY, "neighbour grid for %zu particles is too large", np);
+        if ((rc = replace_buffer((void **)&g->order, cap, sizeof(uint32_t), "particle order")) ||
+            (rc = replace_buffer((void **)&g->spos, 3 * cap, sizeof(double), "sorted positions"))) {
+            free_np_buffers(g);
+            return mf_error_trace(rc, __FILE__, __LINE__, __func__);
+        }
+        g->alloc_np = cap;
     }
-    g->alloc_np = cap;
+    if (!g->sort_key || g->alloc_sort < np || needs_realloc(g->alloc_sort, np)) {
+        size_t cap = g->alloc_np;
+        free_sort_buffers(g);
+        if ((rc = replace_buffer((void **)&g->sort_key, 2 * cap, sizeof(uint64_t), "sort keys")) ||
+            (rc = replace_buffer((void **)&g->sort_idx, 2 * cap, sizeof(uint32_t),
+                                 "sort indices"))) {
+            free_sort_buffers(g);
+            return mf_error_trace(rc, __FILE__, __LINE__, __func__);
+        }
+        g->alloc_sort = cap;
+    }
     return 0;
+}
+
+void mf_grid_release_scratch(mf_grid *g)
+{
+    if (g)
+        free_sort_buffers(g);
 }
 
 static void free_cell_buffers(mf_grid *g)
@@ -144,10 +168,9 @@ size_t mf_grid_memory(const mf_grid *g)
 {
     if (!g)
         return 0;
-    size_t per_particle = sizeof(uint32_t) + 3 * sizeof(double) + 2 * sizeof(uint64_t) +
-                          2 * sizeof(uint32_t);
+    size_t bytes = g->alloc_np * (sizeof(uint32_t) + 3 * sizeof(double)) +
+                   g->alloc_sort * 2 * (sizeof(uint64_t) + sizeof(uint32_t));
     size_t per_cell = sizeof(uint64_t) + sizeof(uint32_t) + g->alloc_rows * sizeof(uint32_t);
-    size_t bytes = g->alloc_np * per_particle;
     if (g->cell_start)
         bytes += g->alloc_cells * per_cell + sizeof(uint32_t);
     bytes += g->hash_cap * (sizeof(uint64_t) + sizeof(uint32_t));

@@ -48,12 +48,12 @@ typedef struct mf_grid {
     size_t hash_cap;       /* power of two, >= 2 * ncells */
     uint64_t *hash_key;
     uint32_t *hash_cell;   /* UINT32_MAX marks an empty slot */
-    size_t alloc_np, alloc_cells, alloc_rows; /* capacities, to reuse memory between builds */
+    size_t alloc_np, alloc_cells, alloc_rows, alloc_sort; /* capacities, reused between builds */
     size_t nbox[3];        /* bounding box size in cells per axis (nbox[2] = 1 in 2-D) */
     double *spos;          /* 3 * alloc_np: positions in cell order (order[k]'s at k),
                               x block, then y, then z; copied by mf_grid_build */
-    uint64_t *sort_key;    /* 2 * alloc_np: radix sort keys (double buffer); scratch */
-    uint32_t *sort_idx;    /* 2 * alloc_np: radix sort payload (double buffer) */
+    uint64_t *sort_key;    /* 2 * alloc_sort: radix sort keys (double buffer); scratch */
+    uint32_t *sort_idx;    /* 2 * alloc_sort: radix sort payload (double buffer) */
     uint32_t *cell_rows;   /* per cell, (2 reach + 1)^(dim-1) rows along x of the cells
                               around it, (dz, dy) ascending: the first occupied cell of
                               the row within reach along x, or UINT32_MAX */
@@ -94,6 +94,9 @@ long mf_grid_find_cell(const mf_grid *g, uint64_t key);
  * perm[k] = old index of the particle now at k. Copies g->order. */
 int mf_grid_locality_order(const mf_grid *g, size_t *perm);
 size_t mf_grid_memory(const mf_grid *g);
+/* Free the build's scratch (the radix sort's buffers, 24 bytes a particle);
+ * the next build allocates it again. The grid stays usable. */
+void mf_grid_release_scratch(mf_grid *g);
 /* Occupied cell containing point x, or -1 (empty cell or outside the box). */
 long mf_grid_point_cell(const mf_grid *g, const double x[3]);
 /* keys[i] for i in [0, p->n): the cells of the grid mf_grid_build(p,
@@ -121,6 +124,8 @@ int mf_nlist_filter(mf_nlist *nl, const mf_nlist *from, const mf_particles *p, d
  * gives. Cheap when the list is nearly in order already (insertion sort). */
 void mf_nlist_sort(mf_nlist *nl, const uint64_t *keys, bool packed);
 size_t mf_nlist_memory(const mf_nlist *nl);
+/* Free the build's scratch (the candidate bits); the list stays usable. */
+void mf_nlist_release_scratch(mf_nlist *nl);
 
 /* ---- the neighbour service --------------------------------------------- */
 

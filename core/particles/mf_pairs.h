@@ -155,7 +155,7 @@ typedef struct mf_rows {
     const long *col_of;  /* particle -> local column (>= 0), or -1: a known value */
     int64_t col_offset;  /* global column = col_offset + col_of[j] */
     size_t *rowptr;      /* rows + 1 */
-    int64_t *col;
+    int32_t *col;        /* 32-bit global columns (mf_csr) */
     double *val;
 } mf_rows;
 
@@ -217,12 +217,12 @@ MF_ENGINE double mf_pairs_row_assemble(const mf_pairs *v, size_t i, const uint8_
     const uint32_t *jl = v->j;
     const double r2max = v->r2;
     const long *col_of = rows->col_of;
-    int64_t *col = rows->col;
+    int32_t *col = rows->col;
     double *val = rows->val;
     const int64_t offset = rows->col_offset;
     const double xi = pos[3 * i], yi = pos[3 * i + 1], zi = pos[3 * i + 2];
     size_t at = rows->rowptr[row];
-    col[at++] = offset + col_of[i];
+    col[at++] = (int32_t)(offset + col_of[i]);
     double sum = 0.0;
     mf_pair pr;
     pr.i = i;
@@ -247,7 +247,7 @@ MF_ENGINE double mf_pairs_row_assemble(const mf_pairs *v, size_t i, const uint8_
         sum += a;
         const long c = col_of[j];
         if (c >= 0) {
-            col[at] = offset + c;
+            col[at] = (int32_t)(offset + c);
             val[at++] = -a;
         } else if (known) {
             known(acc, ctx, &pr, a);

@@ -36,7 +36,11 @@
 /* The largest request of radius at most this share of its class's gets a
  * list of its own, made in the same pass (mf_nlist_build_pair): the
  * gradient at 2.1 l0 beside a Laplacian at 3.1 l0 visits half the pairs.
- * Smaller requests of the class use it too while it holds their pairs. */
+ * Smaller requests of the class use it too while it holds their pairs. A
+ * build makes it when the last list's life had a use for it (the collision
+ * model's radius in a 3-D case, where every operator has the same radius,
+ * asks for pairs only where the sub-list no longer holds them: none is
+ * made, and its memory is not spent). */
 #define SUB_SHARE 0.8
 /* A list serves radius r while r + 2d <= R (1 - MARGIN): rounding of the
  * distances cannot matter at that margin. */
@@ -58,6 +62,8 @@ typedef struct nb_class {
     mf_nlist sub;       /* the sub-list (see SUB_SHARE) */
     double sub_radius;  /* the request it serves; 0: none at the last build */
     double sub_list_radius; /* sub_radius + the skin of the build */
+    bool sub_wanted;    /* a request the sub-list would have served came during this life */
+    bool built_once;
 } nb_class;
 
 typedef struct nb_handle {
@@ -250,11 +256,19 @@ static int build(mf_neighbours *nb, nb_class *c, const mf_particles *p)
         if (nb->handle[k].cls == self && r <= SUB_SHARE * c->radius && r > c->sub_radius)
             c->sub_radius = r;
     }
+    if (c->built_once && !c->sub_wanted)
+        c->sub_radius = 0;
+    c->sub_wanted = false;
+    c->built_once = true;
     c->sub_list_radius = c->sub_radius > 0 ? c->sub_radius + c->skin : 0;
     if (c->sub_radius > 0)
         MF_CALL(mf_nlist_build_pair(&c->list, &c->sub, &c->grid, p, R, c->sub_list_radius));
     else
         MF_CALL(mf_nlist_build(&c->list, &c->grid, p, R));
+    /* The builds' scratch is a fifth of the lists' memory; a run holds the
+     * lists while the pressure solve's memory peaks, the scratch need not. */
+    mf_nlist_release_scratch(&c->list);
+    mf_grid_release_scratch(&c->grid);
     const size_t np = p->n;
     if (np > c->cap_id) {
         size_t cap = np + np / 8 + 16;
@@ -292,14 +306,17 @@ static int refresh(mf_neighbours *nb, nb_class *c, const mf_particles *p, double
             if (c->d_first < 0)
                 c->d_first = d;
             bool packed = false;
-            rc = mf_grid_keys(p, c->cell, c->grid.sort_key, &packed);
+            uint64_t *keys = malloc((p->n ? p->n : 1) * sizeof *keys);
+            rc = keys ? mf_grid_keys(p, c->cell, keys, &packed)
+                      : MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu sort keys", p->n);
             if (rc == 0) {
-                mf_nlist_sort(&c->list, c->grid.sort_key, packed);
+                mf_nlist_sort(&c->list, keys, packed);
                 if (c->sub_radius > 0)
-                    mf_nlist_sort(&c->sub, c->grid.sort_key, packed);
+                    mf_nlist_sort(&c->sub, keys, packed);
                 c->epoch = nb->epoch;
                 nb->stats.sorts++;
             }
+            free(keys);
         }
     } else {
         if (same) { /* moved too far for the skin: fit it to what is needed */
@@ -336,6 +353,8 @@ int mf_neighbours_pairs(mf_neighbours *nb, const mf_particles *p, int handle, mf
     double d = 0;
     MF_CALL(refresh(nb, c, p, h->radius, &d));
     /* The sub-list while it holds the pairs, else the class's: same order. */
+    if (h->radius <= SUB_SHARE * c->radius && 2 * d <= c->skin)
+        c->sub_wanted = true;
     if (h->radius <= c->sub_radius &&
         h->radius + 2 * d <= c->sub_list_radius * (1 - MARGIN))
         *out = mf_pairs_of_list(p, &c->sub, h->radius);
@@ -359,6 +378,7 @@ int mf_neighbours_grid(mf_neighbours *nb, const mf_particles *p, double cell,
         return MF_ERROR(MF_ERR_INPUT, "the run has no neighbour service (mf_neighbours_create)");
     const double t0 = now();
     int rc = mf_grid_build(&nb->points, p, cell);
+    mf_grid_release_scratch(&nb->points);
     nb->stats.seconds += now() - t0;
     MF_CALL(rc);
     *out = &nb->points;
@@ -376,6 +396,7 @@ int mf_neighbours_locality_order(mf_neighbours *nb, const mf_particles *p, int h
     int rc = mf_grid_build(&c->grid, p, c->cell);
     if (rc == 0)
         rc = mf_grid_locality_order(&c->grid, perm);
+    mf_grid_release_scratch(&c->grid);
     nb->stats.seconds += now() - t0;
     MF_CALL(rc);
     return 0;

@@ -41,6 +41,15 @@ void mf_nlist_free(mf_nlist *nl)
     mf_nlist_init(nl);
 }
 
+void mf_nlist_release_scratch(mf_nlist *nl)
+{
+    if (!nl)
+        return;
+    free(nl->work);
+    nl->work = NULL;
+    nl->work_bytes = 0;
+}
+
 size_t mf_nlist_memory(const mf_nlist *nl)
 {
     if (!nl)

@@ -201,6 +201,11 @@ int mps_assemble_ppe(mps_data *d, const mf_sim *sim, double dt)
         d->row[i] = d->in_ppe[i] ? (long)nrows++ : -1;
     if (d->periodic) /* an image is its owner's unknown */
         mps_periodic_sync(d, p, d->row, sizeof *d->row);
+    if (p->global_offset + (int64_t)nrows > MF_CSR_MAX_GLOBAL)
+        return MF_ERROR(MF_ERR_INPUT,
+                        "%zu pressure unknowns: the matrix's columns are 32-bit (hypre's "
+                        "HYPRE_BigInt), at most %d in all",
+                        nrows, MF_CSR_MAX_GLOBAL);
     MF_CALL(reserve_system(d, nrows, 0));
     uint8_t *touches = calloc(nrows ? nrows : 1, 1);
     if (!touches)

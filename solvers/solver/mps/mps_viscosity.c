@@ -104,8 +104,8 @@ static int reserve(mps_viscosity *v, size_t np, size_t rows, size_t nnz)
         v->cap_rows = cap;
     }
     if (nnz > v->cap_nnz) {
-        size_t cap = nnz + nnz / 4 + 64;
-        int64_t *col = realloc(v->A.col, cap * sizeof *col);
+        size_t cap = nnz + nnz / 16 + 64;
+        int32_t *col = realloc(v->A.col, cap * sizeof *col);
         if (col)
             v->A.col = col;
         double *val = realloc(v->A.val, cap * sizeof *val);
@@ -217,6 +217,11 @@ int mps_viscosity_implicit(mps_data *d, mf_sim *sim, double dt)
         v->row[i] = d->is_fluid[i] ? (long)rows++ : -1;
     for (size_t j = p->n_owned; j < p->n; j++) /* periodic images: their owner's row */
         v->row[j] = v->row[mps_owner(d, p, j)];
+    if (p->global_offset + (int64_t)rows > MF_CSR_MAX_GLOBAL)
+        return MF_ERROR(MF_ERR_INPUT,
+                        "%zu viscous unknowns: the matrix's columns are 32-bit (hypre's "
+                        "HYPRE_BigInt), at most %d in all",
+                        rows, MF_CSR_MAX_GLOBAL);
     MF_CALL(reserve(v, p->n, rows, 0)); /* the entries: counted by assemble */
     v->A.nrows = rows;
     v->A.row_offset = p->global_offset;
