@@ -15,6 +15,7 @@
 
 #include "mf_error.h"
 #include "mf_mesh_writer.h"
+#include "mf_timetext.h"
 
 #define PATH_MAX_LEN 4352
 
@@ -440,11 +441,12 @@ int mf_mesh_write_xdmf_index(const char *dir, const char *prefix)
                       "GridType=\"Collection\" CollectionType=\"Temporal\">\n",
                       prefix) > 0;
     for (size_t k = 0; ok && k < u; k++) {
-        char file[256];
+        char file[256], time[32];
         snprintf(file, sizeof file, "%s_%06d.h5", prefix, fr[k].index);
+        mf_time_text(fr[k].time, time, sizeof time);
         ok = fprintf(f,
                      "   <Grid Name=\"%s_%06d\" GridType=\"Uniform\">\n"
-                     "    <Time Value=\"%.17g\"/>\n"
+                     "    <Time Value=\"%s\"/>\n"
                      "    <Topology TopologyType=\"Triangle\" NumberOfElements=\"%lld\">\n"
                      "     <DataItem Dimensions=\"%lld 3\" NumberType=\"Int\" Precision=\"4\" "
                      "Format=\"HDF\">%s:/Triangles</DataItem>\n"
@@ -458,7 +460,7 @@ int mf_mesh_write_xdmf_index(const char *dir, const char *prefix)
                      "Format=\"HDF\">%s:/Normals</DataItem>\n"
                      "    </Attribute>\n"
                      "   </Grid>\n",
-                     prefix, fr[k].index, fr[k].time, fr[k].ntris, fr[k].ntris, file,
+                     prefix, fr[k].index, time, fr[k].ntris, fr[k].ntris, file,
                      fr[k].nverts, file, fr[k].nverts, file) > 0;
     }
     ok = ok && fprintf(f, "  </Grid>\n </Domain>\n</Xdmf>\n") > 0;
