@@ -194,6 +194,7 @@ int mf_app_setup(mf_app *app)
     sim->log = &app->log;
     sim->reg = app->reg;
     MF_CALL(mf_case_read(app->opt.case_dir, &app->cs));
+    MF_CALL(mf_app_check_output(app));
     MF_CALL(load_case_libs(app));
     const mf_control *c = &app->cs.control;
     sim->time = c->start_time;
@@ -229,6 +230,10 @@ int mf_app_setup(mf_app *app)
     run->ctl.write_by_steps = strcmp(c->write_control, "timeStep") == 0;
     run->ctl.write_interval = c->write_interval;
     run->ctl.max_retries = c->max_retries;
+    MF_CALL(mf_stop_at_parse(c->stop_at, &run->ctl.stop_at));
+    run->ctl.purge_write = c->purge_write;
+    if (c->run_time_modifiable)
+        MF_CALL(mf_app_watch_control(app));
     run->solver_ops = (const mf_solver_ops *)app->solver.info;
     run->solver = &app->solver;
     run->writer_ops = (const mf_writer_ops *)app->writer.info;
@@ -268,6 +273,7 @@ void mf_app_teardown(mf_app *app)
     free(app->sim.forces);
     free(app->sim.wall_boxes);
     mf_watch_free(&app->run.watch);
+    mf_app_unwatch_control(app);
     mf_emitters_destroy(app->sim.emitters);
     app->sim.emitters = NULL;
     mf_particles_destroy(app->sim.p);

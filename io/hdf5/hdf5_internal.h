@@ -125,6 +125,8 @@ typedef struct mf_xdmf_index {
 int mf_xdmf_describe(const char *output_dir, int index, mf_xdmf_snap *s);
 /* Add (or replace the entry with the same index); takes ownership of s. */
 int mf_xdmf_index_add(mf_xdmf_index *x, mf_xdmf_snap *s);
+/* Drop the entry of snapshot `index` (purgeWrite), if listed. */
+void mf_xdmf_index_remove(mf_xdmf_index *x, int index);
 /* Describe every readable snapshot of the folder (unreadable ones are left
  * out of the index: the reader skips them too). */
 int mf_xdmf_index_scan(mf_xdmf_index *x, const char *output_dir);

@@ -169,6 +169,17 @@ int mf_xdmf_index_add(mf_xdmf_index *x, mf_xdmf_snap *s)
     return 0;
 }
 
+void mf_xdmf_index_remove(mf_xdmf_index *x, int index)
+{
+    for (size_t k = 0; k < x->n; k++)
+        if (x->snap[k].index == index) {
+            snap_free(&x->snap[k]);
+            memmove(&x->snap[k], &x->snap[k + 1], (x->n - k - 1) * sizeof *x->snap);
+            x->n--;
+            return;
+        }
+}
+
 int mf_xdmf_index_scan(mf_xdmf_index *x, const char *output_dir)
 {
     int *indices;
