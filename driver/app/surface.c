@@ -172,7 +172,7 @@ static int run_surface(const surface_opts *o, mf_registry *reg, mf_log *log)
     if (rc == 0)
         rc = write_resolved(out_dir, resolved);
     const mf_surface_ops *ops = rc == 0 ? (const mf_surface_ops *)m.info : NULL;
-    int frames = 0;
+    int frames = 0, skipped = 0;
     double t_all = mf_wall_seconds();
     for (size_t k = 0; k < n && rc == 0; k++) {
         if (!sel[k])
@@ -184,6 +184,17 @@ static int run_surface(const surface_opts *o, mf_registry *reg, mf_log *log)
         sim.reg = reg;
         double t0 = mf_wall_seconds();
         rc = mf_hdf5_read_snapshot(path, &sim);
+        size_t counts[MF_NKINDS] = {0};
+        if (rc == 0)
+            mf_particles_count_kinds(sim.p, counts);
+        if (rc == 0 && counts[MF_FLUID] == 0) {
+            /* A scene that fills over time starts empty: nothing to mesh yet. */
+            mf_log_printf(log, MF_LOG_QUIET, "surface: time %g (%s): no fluid yet, skipped\n",
+                          sim.time, path);
+            skipped++;
+            mf_particles_destroy(sim.p);
+            continue;
+        }
         if (rc == 0) {
             mf_log_printf(log, MF_LOG_NORMAL, "\nTime = %g  (%s)\n", sim.time, path);
             rc = ops->reconstruct(m.data, &sim, &mesh);
@@ -203,9 +214,9 @@ static int run_surface(const surface_opts *o, mf_registry *reg, mf_log *log)
     }
     if (rc == 0)
         mf_log_printf(log, MF_LOG_QUIET,
-                      "\nsurface (%s): %d frames in %.2f s, peak memory %.1f MB; ParaView: "
-                      "open %s/surface.xdmf\nEnd\n",
-                      s.method, frames, mf_wall_seconds() - t_all,
+                      "\nsurface (%s): %d frames (%d snapshot(s) without fluid skipped) in "
+                      "%.2f s, peak memory %.1f MB; ParaView: open %s/surface.xdmf\nEnd\n",
+                      s.method, frames, skipped, mf_wall_seconds() - t_all,
                       mf_peak_memory() / 1048576.0, out_dir);
     surface_close(&m);
     mf_mesh_free(&mesh);

@@ -2,7 +2,8 @@
  * index of a surface time series (mf_mesh_writer.h).
  *
  * PLY (Turk 1994; the format as Blender's importer reads it): an ASCII
- * header, then little-endian records; vertices as six float32 (position,
+ * header (its comments: the time, and that y is up, the case's axes), then
+ * little-endian records; vertices as six float32 (position,
  * normal), faces as a uchar count (3) and three int32 indices. */
 #include <dirent.h>
 #include <errno.h>
@@ -96,7 +97,8 @@ int mf_mesh_write_ply(const char *path, const mf_mesh *m)
         return MF_ERROR(MF_ERR_IO, "%s: cannot open for writing (%s)", tmp, strerror(errno));
     bool ok = fprintf(f,
                       "ply\nformat binary_little_endian 1.0\ncomment mpsflow surface, time "
-                      "%.17g\nelement vertex %zu\nproperty float x\nproperty float y\nproperty "
+                      "%.17g\ncomment axes of the case: y is up (Blender, z up: "
+                      "mpsflowBlenderImport.py turns it)\nelement vertex %zu\nproperty float x\nproperty float y\nproperty "
                       "float z\nproperty float nx\nproperty float ny\nproperty float nz\nelement "
                       "face %zu\nproperty list uchar int vertex_indices\nend_header\n",
                       m->time, m->nverts, m->ntris) > 0;
