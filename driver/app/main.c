@@ -138,7 +138,13 @@ static int parse_options(int argc, char **argv, int first, mf_options *opt)
 }
 
 /* Plugins built with mpsflow sit in ../plugins beside driver/ in the build
- * tree, or in ../lib/mpsflow beside bin/ when installed. */
+ * tree, or, installed, in the plugin folder at MPSFLOW_PLUGIN_RELDIR from
+ * bin/ (meson's libdir/mpsflow: ../lib/x86_64-linux-gnu/mpsflow on Debian),
+ * found from where the executable is, so that an installed tree works
+ * wherever it is put (meson install --destdir, a moved prefix). */
+#ifndef MPSFLOW_PLUGIN_RELDIR
+#define MPSFLOW_PLUGIN_RELDIR "../lib/mpsflow"
+#endif
 static void set_plugin_dirs(mf_registry *reg)
 {
     char exe[PATH_MAX], dirs[3 * PATH_MAX];
@@ -150,7 +156,10 @@ static void set_plugin_dirs(mf_registry *reg)
     if (!slash)
         return;
     *slash = '\0';
-    snprintf(dirs, sizeof dirs, "%s/../plugins:%s/../lib/mpsflow", exe, exe);
+    if (MPSFLOW_PLUGIN_RELDIR[0] == '/')
+        snprintf(dirs, sizeof dirs, "%s/../plugins:%s", exe, MPSFLOW_PLUGIN_RELDIR);
+    else
+        snprintf(dirs, sizeof dirs, "%s/../plugins:%s/%s", exe, exe, MPSFLOW_PLUGIN_RELDIR);
     mf_registry_set_plugin_dir(reg, dirs);
 }
 
