@@ -89,7 +89,7 @@ set_key "$c" endTime abc   # a broken edit: reported, the run goes on
 wait_for 30 "grep -q \"key 'endTime': expected a number\" '$c/log'" ||
     fail "runTimeModifiable: a broken controlDict was not reported"
 now=$("$mpsflow" listTimes -case "$c" -latestTime)
-new=$(awk -v t="$now" 'BEGIN { printf "%.2f", t + 0.15 }')
+new=$(awk -v t="$now" 'BEGIN { printf "%.2f", t + 0.15 }' | awk '{ print $1 + 0 }')
 set_key "$c" endTime "$new"
 wait_for 60 '! kill -0 $pid 2> /dev/null'
 wait "$pid"; status=$?; pid=""

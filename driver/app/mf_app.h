@@ -96,8 +96,9 @@ struct mf_metric;
 int mf_metric_evaluate(const char *case_dir, const char *name, const int *selected,
                        size_t nselected, const char *out_dir, double *error,
                        const struct mf_metric **used);
-/* Why output/runSummary says the run did not reach endTime ("" if it did). */
-void mf_run_status_note(const char *case_dir, char *note, size_t len);
+/* Why output/runSummary says the run did not reach endTime ("" if it did);
+ * false when there is no runSummary. Clears the error trace. */
+bool mf_run_status_note(const char *case_dir, char *note, size_t len);
 
 /* `mpsflow compare`: see compare.c (-endTime is passed to each run). */
 int mf_cmd_compare(const mf_options *o);

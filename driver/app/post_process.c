@@ -160,8 +160,8 @@ static int replay_metric(replay *r, const char *name)
     snprintf(out_dir, sizeof out_dir, "%s/postProcessing/%s", app->cs.dir, name);
     MF_CALL(make_dir(out_dir));
     double error = 0;
-    MF_CALL(mf_metric_evaluate(app->cs.dir, name, r->idx, r->n, out_dir, &error, NULL));
     mf_run_status_note(app->cs.dir, note, sizeof note);
+    MF_CALL(mf_metric_evaluate(app->cs.dir, name, r->idx, r->n, out_dir, &error, NULL));
     printf("error %s = %.6g%s%s%s\n", name, error, note[0] ? " (not a finished run's: " : "",
            note, note[0] ? ")" : "");
     mf_log_printf(&app->log, MF_LOG_QUIET, "-postProcess: %s over %zu snapshot(s) -> %s\n", name,

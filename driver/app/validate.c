@@ -52,22 +52,25 @@ int mf_metric_evaluate(const char *case_dir, const char *name, const int *select
 }
 
 /* "" when output/runSummary says the run reached its endTime, else why not
- * ("unstable (timeStep) at time 0.4 of endTime 0.6"). */
-void mf_run_status_note(const char *case_dir, char *note, size_t len)
+ * ("unstable (timeStep) at time 0.4 of endTime 0.6"). Returns whether there
+ * is a runSummary. Clears the error trace (call it before anything that
+ * may fail). */
+bool mf_run_status_note(const char *case_dir, char *note, size_t len)
 {
     mf_run_summary s;
     mf_read_run_summary(case_dir, &s);
     note[0] = '\0';
     if (!strcmp(s.status, "completed"))
-        return;
+        return true;
     if (!strcmp(s.status, "no summary")) {
         snprintf(note, len, "no output/runSummary: the run did not finish (killed?)");
-        return;
+        return false;
     }
     snprintf(note, len, "%s%s%s%s at time %.6g of endTime %.6g", s.status,
              s.criterion[0] && strcmp(s.criterion, "none") ? " (" : "",
              s.criterion[0] && strcmp(s.criterion, "none") ? s.criterion : "",
              s.criterion[0] && strcmp(s.criterion, "none") ? ")" : "", s.time, s.end_time);
+    return true;
 }
 
 int mf_cmd_validate(const char *case_dir, double *error)
@@ -75,9 +78,9 @@ int mf_cmd_validate(const char *case_dir, double *error)
     char out_dir[4200], note[256];
     snprintf(out_dir, sizeof out_dir, "%s/validation", case_dir);
     const mf_metric *m = NULL;
+    const bool summary = mf_run_status_note(case_dir, note, sizeof note);
     int rc = mf_metric_evaluate(case_dir, NULL, NULL, 0, out_dir, error, &m);
-    mf_run_status_note(case_dir, note, sizeof note);
-    if (rc != 0 && note[0] && rc != MF_ERR_MEMORY)
+    if (rc != 0 && summary && note[0] && rc != MF_ERR_MEMORY)
         return MF_ERROR(rc, "%s (the run: %s)", mf_error_message(), note);
     MF_CALL(rc);
     if (note[0]) {

@@ -105,6 +105,11 @@ static const struct { const char *name, *unit; } unit_table[] = {
     {"Acceleration", "m/s^2"},
     {"Temperature", "K"},
     {"Vorticity", "1/s"},
+    {"LightPressure", "Pa"},          /* multiFluid: the gas pass of the two-step pressure */
+    {"Curvature", "1/m"},             /* surfaceTension */
+    {"SurfaceTension", "m/s^2"},      /* surfaceTension: its acceleration */
+    {"ConvectionVelocity", "m/s"},    /* MPS-MAFL */
+    {"PointVelocity", "m/s"},         /* MPS-MAFL */
 };
 
 const char *mf_h5_unit(const char *dataset)
