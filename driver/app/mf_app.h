@@ -55,6 +55,10 @@ int mf_register_builtins(mf_registry *reg);
 
 /* Load plugins named in a list text such as "(libfoo.so bar)". */
 int mf_app_load_libs_text(mf_registry *reg, const char *text);
+/* The `libs` of one function's dictionary (functions { NAME { libs (...); } }). */
+int mf_app_load_function_libs(mf_registry *reg, const mf_dict *fd);
+/* Load the plugins of controlDict's `libs` (after the case is read). */
+int mf_app_load_case_libs(mf_app *app);
 /* Read the case, build the scene and create the modules it names. */
 int mf_app_setup(mf_app *app);
 void mf_app_teardown(mf_app *app);

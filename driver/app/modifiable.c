@@ -48,12 +48,31 @@ void mf_app_unwatch_control(mf_app *app)
     app->control_watch.tree = NULL;
 }
 
-#define CHANGED_NUM(field) (fresh.field != w->file.field)
-
 static void say(mf_app *app, const char *key, double from, double to)
 {
     mf_log_printf(&app->log, MF_LOG_QUIET, "--> controlDict changed: %s %g -> %g (at time %g)\n",
                   key, from, to, app->sim.time);
+}
+
+/* A key whose value in the file changed: the run takes it (and `also`, a
+ * copy kept elsewhere, may be NULL). */
+static void take(mf_app *app, const char *key, double fresh, double before, double *dst,
+                 double *also)
+{
+    if (fresh == before)
+        return;
+    say(app, key, *dst, fresh);
+    *dst = fresh;
+    if (also)
+        *also = fresh;
+}
+
+static void take_long(mf_app *app, const char *key, long fresh, long before, long *dst)
+{
+    if (fresh == before)
+        return;
+    say(app, key, (double)*dst, (double)fresh);
+    *dst = fresh;
 }
 
 int mf_app_control_modified(void *ctx, mf_run *run)
@@ -76,58 +95,33 @@ int mf_app_control_modified(void *ctx, mf_run *run)
     }
     mf_run_control *c = &run->ctl;
     mf_sim *sim = run->sim;
-    if (CHANGED_NUM(end_time)) {
-        say(app, "endTime", sim->end_time, fresh.end_time);
-        sim->end_time = fresh.end_time;
-    }
-    if (strcmp(fresh.stop_at, w->file.stop_at) != 0) {
+    const mf_control *was = &w->file;
+    take(app, "endTime", fresh.end_time, was->end_time, &sim->end_time, NULL);
+    if (strcmp(fresh.stop_at, was->stop_at) != 0) {
         mf_stop_at s = MF_STOP_END_TIME;
         MF_CALL(mf_stop_at_parse(fresh.stop_at, &s));
         mf_log_printf(&app->log, MF_LOG_QUIET, "--> controlDict changed: stopAt %s -> %s (at time %g)\n",
                       mf_stop_at_name(c->stop_at), fresh.stop_at, sim->time);
         c->stop_at = s;
     }
-    if (CHANGED_NUM(write_interval)) {
-        say(app, "writeInterval", c->write_interval, fresh.write_interval);
-        c->write_interval = fresh.write_interval;
-    }
-    if (CHANGED_NUM(delta_t)) {
-        say(app, "deltaT", c->delta_t, fresh.delta_t);
-        c->delta_t = fresh.delta_t;
-    }
-    if (CHANGED_NUM(max_co)) {
-        say(app, "maxCo", c->max_co, fresh.max_co);
-        c->max_co = sim->max_courant = fresh.max_co;
-    }
-    if (CHANGED_NUM(max_di)) {
-        say(app, "maxDi", c->max_di, fresh.max_di);
-        c->max_di = fresh.max_di;
-    }
-    if (CHANGED_NUM(max_delta_t)) {
-        say(app, "maxDeltaT", c->max_delta_t, fresh.max_delta_t);
-        c->max_delta_t = sim->max_dt = fresh.max_delta_t;
-    }
-    if (CHANGED_NUM(min_delta_t)) {
-        say(app, "minDeltaT", c->min_delta_t, fresh.min_delta_t);
-        c->min_delta_t = fresh.min_delta_t;
-    }
-    if (CHANGED_NUM(max_retries)) {
-        say(app, "maxRetries", (double)c->max_retries, (double)fresh.max_retries);
-        c->max_retries = fresh.max_retries;
-    }
-    if (CHANGED_NUM(purge_write)) {
-        say(app, "purgeWrite", (double)c->purge_write, (double)fresh.purge_write);
-        c->purge_write = fresh.purge_write;
-    }
+    take(app, "writeInterval", fresh.write_interval, was->write_interval, &c->write_interval, NULL);
+    take(app, "deltaT", fresh.delta_t, was->delta_t, &c->delta_t, NULL);
+    take(app, "maxCo", fresh.max_co, was->max_co, &c->max_co, &sim->max_courant);
+    take(app, "maxDi", fresh.max_di, was->max_di, &c->max_di, NULL);
+    take(app, "maxDeltaT", fresh.max_delta_t, was->max_delta_t, &c->max_delta_t, &sim->max_dt);
+    take(app, "minDeltaT", fresh.min_delta_t, was->min_delta_t, &c->min_delta_t, NULL);
+    take_long(app, "maxRetries", fresh.max_retries, was->max_retries, &c->max_retries);
+    take_long(app, "purgeWrite", fresh.purge_write, was->purge_write, &c->purge_write);
     if (!fresh.run_time_modifiable) {
         mf_log_printf(&app->log, MF_LOG_QUIET,
                       "--> controlDict changed: runTimeModifiable no: no more re-reading\n");
         run->modified = NULL;
     }
-    const bool others = CHANGED_NUM(start_time) || CHANGED_NUM(adjust_time_step) ||
-                        strcmp(fresh.write_control, w->file.write_control) != 0 ||
-                        strcmp(fresh.writer, w->file.writer) != 0 ||
-                        strcmp(fresh.start_from, w->file.start_from) != 0;
+    const bool others = fresh.start_time != was->start_time ||
+                        fresh.adjust_time_step != was->adjust_time_step ||
+                        strcmp(fresh.write_control, was->write_control) != 0 ||
+                        strcmp(fresh.writer, was->writer) != 0 ||
+                        strcmp(fresh.start_from, was->start_from) != 0;
     if (others)
         mf_log_printf(&app->log, MF_LOG_QUIET,
                       "--> mpsflow Warning: controlDict: startTime, adjustTimeStep, writeControl, "

@@ -175,11 +175,7 @@ static int replay_one(replay *r, const char *name)
     const mf_dict *fns = mf_dict_subdict(app->cs.control_dict, "functions");
     const mf_dict *fd = fns ? mf_dict_subdict(fns, name) : NULL;
     if (fd) {
-        mf_entry *libs = mf_dict_find(fd, "libs");
-        for (size_t i = 0; libs && libs->n == 1 && libs->items[0]->kind == MF_VAL_LIST &&
-                           i < libs->items[0]->n;
-             i++)
-            MF_CALL(mf_registry_load_plugin(app->reg, libs->items[0]->items[i]->text));
+        MF_CALL(mf_app_load_function_libs(app->reg, fd));
         const char *type;
         MF_CALL(mf_dict_get_word(fd, "type", &type));
         return replay_function(r, name, fd, type);
@@ -216,16 +212,7 @@ int mf_cmd_post_process(mf_app *app)
     app->sim.log = &app->log;
     app->sim.reg = app->reg;
     MF_CALL(mf_case_read(o->case_dir, &app->cs));
-    {
-        const char **libs = NULL;
-        size_t nlibs = 0;
-        MF_CALL(mf_case_libs(&app->cs, &libs, &nlibs));
-        int rc = 0;
-        for (size_t k = 0; k < nlibs && rc == 0; k++)
-            rc = mf_registry_load_plugin(app->reg, libs[k]);
-        free(libs);
-        MF_CALL(rc);
-    }
+    MF_CALL(mf_app_load_case_libs(app));
     MF_CALL(mf_scene_read_fluids(app->cs.fluids, &app->sim));
     int *idx = NULL;
     double *times = NULL;
