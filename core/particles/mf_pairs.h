@@ -65,6 +65,28 @@ typedef struct mf_pair {
     double len;   /* |r_ij| */
 } mf_pair;
 
+/* Entry k of the view as the pair (xi, yi, zi: i's position): false when
+ * it is not closer than the view's radius. r_ij = r_j - r_i and |r_ij|^2 =
+ * (x^2 + y^2) + z^2 exactly as the list build computes them (z = 0 in 2-D),
+ * so that the view's pairs are the list build's at that radius. */
+MF_ENGINE bool mf_pairs_entry(const mf_pairs *v, uint32_t k, double xi, double yi, double zi,
+                              mf_pair *pr)
+{
+    const size_t j = v->j[k];
+    const double *xj = v->pos + 3 * j;
+    const double dx = xj[0] - xi, dy = xj[1] - yi, dz = xj[2] - zi;
+    const double r2 = dx * dx + dy * dy + dz * dz;
+    if (!(r2 < v->r2))
+        return false;
+    pr->j = j;
+    pr->r[0] = dx;
+    pr->r[1] = dy;
+    pr->r[2] = dz;
+    pr->r2 = r2;
+    pr->len = sqrt(r2);
+    return true;
+}
+
 /* Adds one pair to the accumulator acc; returns false to end the row. */
 typedef bool (*mf_pair_kernel)(void *acc, const void *ctx, const mf_pair *pr);
 
@@ -72,28 +94,16 @@ typedef bool (*mf_pair_kernel)(void *acc, const void *ctx, const mf_pair *pr);
 MF_ENGINE void mf_pairs_row(const mf_pairs *v, size_t i, const uint8_t *jmask,
                             mf_pair_kernel kernel, const void *ctx, void *acc)
 {
-    const double *pos = v->pos;
-    const uint32_t *jl = v->j;
+    /* A local copy: its fields stay in registers across the kernel's calls. */
+    const mf_pairs w = *v;
+    const double *pos = w.pos;
     const double xi = pos[3 * i], yi = pos[3 * i + 1], zi = pos[3 * i + 2];
-    const double r2max = v->r2;
     mf_pair pr;
     pr.i = i;
-    for (uint32_t k = v->start[i], end = v->start[i + 1]; k < end; k++) {
-        const size_t j = jl[k];
-        if (jmask && !jmask[j])
+    for (uint32_t k = w.start[i], end = w.start[i + 1]; k < end; k++) {
+        if (jmask && !jmask[w.j[k]])
             continue;
-        const double *xj = pos + 3 * j;
-        const double dx = xj[0] - xi, dy = xj[1] - yi, dz = xj[2] - zi;
-        const double r2 = dx * dx + dy * dy + dz * dz;
-        if (!(r2 < r2max))
-            continue;
-        pr.j = j;
-        pr.r[0] = dx;
-        pr.r[1] = dy;
-        pr.r[2] = dz;
-        pr.r2 = r2;
-        pr.len = sqrt(r2);
-        if (!kernel(acc, ctx, &pr))
+        if (mf_pairs_entry(&w, k, xi, yi, zi, &pr) && !kernel(acc, ctx, &pr))
             break;
     }
 }
@@ -105,31 +115,18 @@ MF_ENGINE void mf_pairs_row(const mf_pairs *v, size_t i, const uint8_t *jmask,
 MF_ENGINE size_t mf_pairs_gather(const mf_pairs *v, size_t i, const uint8_t *jmask,
                                  mf_pair *buf, size_t cap)
 {
-    const double *pos = v->pos;
-    const uint32_t *jl = v->j;
+    /* A local copy: its fields stay in registers across the kernel's calls. */
+    const mf_pairs w = *v;
+    const double *pos = w.pos;
     const double xi = pos[3 * i], yi = pos[3 * i + 1], zi = pos[3 * i + 2];
-    const double r2max = v->r2;
     size_t n = 0;
-    for (uint32_t k = v->start[i], end = v->start[i + 1]; k < end; k++) {
-        const size_t j = jl[k];
-        if (jmask && !jmask[j])
+    mf_pair spare;
+    for (uint32_t k = w.start[i], end = w.start[i + 1]; k < end; k++) {
+        if (jmask && !jmask[w.j[k]])
             continue;
-        const double *xj = pos + 3 * j;
-        const double dx = xj[0] - xi, dy = xj[1] - yi, dz = xj[2] - zi;
-        const double r2 = dx * dx + dy * dy + dz * dz;
-        if (!(r2 < r2max))
-            continue;
-        if (n < cap) {
-            mf_pair *pr = &buf[n];
-            pr->i = i;
-            pr->j = j;
-            pr->r[0] = dx;
-            pr->r[1] = dy;
-            pr->r[2] = dz;
-            pr->r2 = r2;
-            pr->len = sqrt(r2);
-        }
-        n++;
+        mf_pair *pr = n < cap ? &buf[n] : &spare;
+        pr->i = i;
+        n += mf_pairs_entry(&w, k, xi, yi, zi, pr);
     }
     return n;
 }
@@ -173,33 +170,26 @@ typedef void (*mf_pair_known)(void *acc, const void *ctx, const mf_pair *pr, dou
 MF_ENGINE size_t mf_pairs_row_count(const mf_pairs *v, size_t i, const uint8_t *jmask,
                                     mf_pair_test test, const void *ctx, const long *col_of)
 {
-    const double *pos = v->pos;
-    const uint32_t *jl = v->j;
-    const double r2max = v->r2;
+    /* A local copy: its fields stay in registers across the kernel's calls. */
+    const mf_pairs w = *v;
+    const double *pos = w.pos;
     const double xi = pos[3 * i], yi = pos[3 * i + 1], zi = pos[3 * i + 2];
     size_t count = 1;
     mf_pair pr;
     pr.i = i;
-    for (uint32_t k = v->start[i], end = v->start[i + 1]; k < end; k++) {
-        const size_t j = jl[k];
+    for (uint32_t k = w.start[i], end = w.start[i + 1]; k < end; k++) {
+        const size_t j = w.j[k];
         if ((jmask && !jmask[j]) || col_of[j] < 0)
             continue;
-        const double *xj = pos + 3 * j;
-        const double dx = xj[0] - xi, dy = xj[1] - yi, dz = xj[2] - zi;
-        const double r2 = dx * dx + dy * dy + dz * dz;
-        if (!(r2 < r2max))
-            continue;
-        if (test) {
-            pr.j = j;
-            pr.r[0] = dx;
-            pr.r[1] = dy;
-            pr.r[2] = dz;
-            pr.r2 = r2;
-            pr.len = sqrt(r2);
-            if (!test(ctx, &pr))
-                continue;
+        /* Without a test the square root is not needed (the compiler drops
+         * it with the unused pair, but not the errno check of a NaN). */
+        if (!test) {
+            const double *xj = pos + 3 * j;
+            const double dx = xj[0] - xi, dy = xj[1] - yi, dz = xj[2] - zi;
+            count += dx * dx + dy * dy + dz * dz < w.r2;
+        } else if (mf_pairs_entry(&w, k, xi, yi, zi, &pr) && test(ctx, &pr)) {
+            count++;
         }
-        count++;
     }
     return count;
 }
@@ -213,9 +203,8 @@ MF_ENGINE double mf_pairs_row_assemble(const mf_pairs *v, size_t i, const uint8_
                                        mf_pair_known known, const void *ctx, void *acc,
                                        const mf_rows *rows, size_t row)
 {
-    const double *pos = v->pos;
-    const uint32_t *jl = v->j;
-    const double r2max = v->r2;
+    const mf_pairs w = *v;
+    const double *pos = w.pos;
     const long *col_of = rows->col_of;
     int32_t *col = rows->col;
     double *val = rows->val;
@@ -226,22 +215,11 @@ MF_ENGINE double mf_pairs_row_assemble(const mf_pairs *v, size_t i, const uint8_
     double sum = 0.0;
     mf_pair pr;
     pr.i = i;
-    for (uint32_t k = v->start[i], end = v->start[i + 1]; k < end; k++) {
-        const size_t j = jl[k];
+    for (uint32_t k = w.start[i], end = w.start[i + 1]; k < end; k++) {
+        const size_t j = w.j[k];
         if (jmask && !jmask[j])
             continue;
-        const double *xj = pos + 3 * j;
-        const double dx = xj[0] - xi, dy = xj[1] - yi, dz = xj[2] - zi;
-        const double r2 = dx * dx + dy * dy + dz * dz;
-        if (!(r2 < r2max))
-            continue;
-        pr.j = j;
-        pr.r[0] = dx;
-        pr.r[1] = dy;
-        pr.r[2] = dz;
-        pr.r2 = r2;
-        pr.len = sqrt(r2);
-        if (test && !test(ctx, &pr))
+        if (!mf_pairs_entry(&w, k, xi, yi, zi, &pr) || (test && !test(ctx, &pr)))
             continue;
         const double a = coef(ctx, &pr);
         sum += a;

@@ -565,15 +565,17 @@ static int plan_bits(mf_nlist *nl, list_build *lb)
         lb->word = NULL;
         return 0;
     }
-    const size_t had = nl->work_bytes;
-    MF_CALL(ensure_work(nl, (np + 1) * sizeof(size_t) + total * sizeof(uint64_t)));
-    if (nl->work != word || nl->work_bytes != had) { /* replaced: plan again into it */
+    const size_t need = (np + 1) * sizeof(size_t) + total * sizeof(uint64_t);
+    if (nl->work_bytes < need) { /* grow, keeping the offsets just planned */
+        size_t cap = with_headroom(need);
+        void *grown = realloc(nl->work, cap);
+        if (!grown)
+            return MF_ERROR(MF_ERR_MEMORY, "cannot allocate neighbour list scratch (%zu bytes)",
+                            cap);
+        nl->work = grown;
+        nl->work_bytes = cap;
         word = nl->work;
         lb->word = word;
-        plan_pass(lb);
-        word[0] = 0;
-        for (size_t k = 0; k < np; k++)
-            word[k + 1] += word[k];
     }
     lb->bits = (uint64_t *)(word + np + 1);
     return 0;
