@@ -131,7 +131,7 @@ static double front_of(const mf_particles *all, double l0, double back_wall, siz
         const mf_pairs v = mf_pairs_of_list(fluid, &nl, radius);
         for (size_t i = 0; i < fluid->n; i++) {
             size_t count = 0;
-            mf_pairs_row(&v, i, NULL, count_pair, NULL, &count);
+            mf_pairs_row_r2(&v, i, NULL, count_pair, NULL, &count);
             if (count >= 2) {
                 (*counted)++;
                 if (fluid->pos[3 * i] - back_wall > z)

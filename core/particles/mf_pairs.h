@@ -69,8 +69,8 @@ typedef struct mf_pair {
  * it is not closer than the view's radius. r_ij = r_j - r_i and |r_ij|^2 =
  * (x^2 + y^2) + z^2 exactly as the list build computes them (z = 0 in 2-D),
  * so that the view's pairs are the list build's at that radius. */
-MF_ENGINE bool mf_pairs_entry(const mf_pairs *v, uint32_t k, double xi, double yi, double zi,
-                              mf_pair *pr)
+MF_ENGINE bool mf_pairs_entry_as(const mf_pairs *v, uint32_t k, double xi, double yi,
+                                 double zi, mf_pair *pr, bool with_len)
 {
     const size_t j = v->j[k];
     const double *xj = v->pos + 3 * j;
@@ -83,16 +83,22 @@ MF_ENGINE bool mf_pairs_entry(const mf_pairs *v, uint32_t k, double xi, double y
     pr->r[1] = dy;
     pr->r[2] = dz;
     pr->r2 = r2;
-    pr->len = sqrt(r2);
+    pr->len = with_len ? sqrt(r2) : NAN;
     return true;
+}
+
+MF_ENGINE bool mf_pairs_entry(const mf_pairs *v, uint32_t k, double xi, double yi, double zi,
+                              mf_pair *pr)
+{
+    return mf_pairs_entry_as(v, k, xi, yi, zi, pr, true);
 }
 
 /* Adds one pair to the accumulator acc; returns false to end the row. */
 typedef bool (*mf_pair_kernel)(void *acc, const void *ctx, const mf_pair *pr);
 
-/* The pairs of particle i (see the top). */
-MF_ENGINE void mf_pairs_row(const mf_pairs *v, size_t i, const uint8_t *jmask,
-                            mf_pair_kernel kernel, const void *ctx, void *acc)
+/* The pairs of particle i (see the top); with_len a literal. */
+MF_ENGINE void mf_pairs_row_as(const mf_pairs *v, size_t i, const uint8_t *jmask,
+                               mf_pair_kernel kernel, const void *ctx, void *acc, bool with_len)
 {
     /* A local copy: its fields stay in registers across the kernel's calls. */
     const mf_pairs w = *v;
@@ -103,32 +109,24 @@ MF_ENGINE void mf_pairs_row(const mf_pairs *v, size_t i, const uint8_t *jmask,
     for (uint32_t k = w.start[i], end = w.start[i + 1]; k < end; k++) {
         if (jmask && !jmask[w.j[k]])
             continue;
-        if (mf_pairs_entry(&w, k, xi, yi, zi, &pr) && !kernel(acc, ctx, &pr))
+        if (mf_pairs_entry_as(&w, k, xi, yi, zi, &pr, with_len) && !kernel(acc, ctx, &pr))
             break;
     }
 }
 
-/* The pairs of particle i as mf_pairs_row finds them, into buf (at most
- * cap; the count found is returned even when larger, and then buf holds the
- * first cap): a kernel that needs two passes over a row (a minimum, then a
- * sum) runs them over the buffer, finding the pairs once. */
-MF_ENGINE size_t mf_pairs_gather(const mf_pairs *v, size_t i, const uint8_t *jmask,
-                                 mf_pair *buf, size_t cap)
+/* The pairs of particle i (see the top). */
+MF_ENGINE void mf_pairs_row(const mf_pairs *v, size_t i, const uint8_t *jmask,
+                            mf_pair_kernel kernel, const void *ctx, void *acc)
 {
-    /* A local copy: its fields stay in registers across the kernel's calls. */
-    const mf_pairs w = *v;
-    const double *pos = w.pos;
-    const double xi = pos[3 * i], yi = pos[3 * i + 1], zi = pos[3 * i + 2];
-    size_t n = 0;
-    mf_pair spare;
-    for (uint32_t k = w.start[i], end = w.start[i + 1]; k < end; k++) {
-        if (jmask && !jmask[w.j[k]])
-            continue;
-        mf_pair *pr = n < cap ? &buf[n] : &spare;
-        pr->i = i;
-        n += mf_pairs_entry(&w, k, xi, yi, zi, pr);
-    }
-    return n;
+    mf_pairs_row_as(v, i, jmask, kernel, ctx, acc, true);
+}
+
+/* The same for a kernel that reads r_ij and |r_ij|^2 only (a minimum, a
+ * count, a distance test): no square root (len is NaN). */
+MF_ENGINE void mf_pairs_row_r2(const mf_pairs *v, size_t i, const uint8_t *jmask,
+                               mf_pair_kernel kernel, const void *ctx, void *acc)
+{
+    mf_pairs_row_as(v, i, jmask, kernel, ctx, acc, false);
 }
 
 /* Computes and stores the result of particle i. */

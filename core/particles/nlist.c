@@ -365,17 +365,30 @@ static inline void axis_span(double x, double origin, double inv_width, double r
     *hi = b > reach ? reach : b < 0 ? 0 : (int)b;
 }
 
-/* The candidate ranges of sorted particle k of the cell: (dz, dy) rows
- * ascending, cells along x ascending, so that hits come in key order. */
-KERNEL int particle_rows(const mf_grid *g, const cell_bounds *cb, const double xi[3],
-                         double radius, double inv_width, int dim, uint32_t *rows)
+/* The candidate ranges of the particles of a cell: the cells that the boxes
+ * [x - R, x + R] of its particles meet (the union over them: the particles
+ * of a cell share one set of rows), (dz, dy) rows ascending, cells along x
+ * ascending, so that hits come in key order. With R up to the cell size that
+ * is the 3^dim block around it, as a single-reach grid always used. */
+KERNEL int cell_rows(const mf_grid *g, const cell_bounds *cb, size_t c, const pair_test *t,
+                     double radius, double inv_width, int dim, uint32_t *rows)
 {
     const int reach = g->reach, w = 2 * reach + 1;
-    int xl, xh, yl, yh, zl = 0, zh = 0;
-    axis_span(xi[0], g->origin[0], inv_width, radius, cb->ix, reach, &xl, &xh);
-    axis_span(xi[1], g->origin[1], inv_width, radius, cb->iy, reach, &yl, &yh);
-    if (dim == 3)
-        axis_span(xi[2], g->origin[2], inv_width, radius, cb->iz, reach, &zl, &zh);
+    int xl = 0, xh = 0, yl = 0, yh = 0, zl = 0, zh = 0;
+    for (size_t k = g->cell_start[c]; k < g->cell_start[c + 1]; k++) {
+        int lo, hi;
+        axis_span(t->sx[k], g->origin[0], inv_width, radius, cb->ix, reach, &lo, &hi);
+        xl = lo < xl ? lo : xl;
+        xh = hi > xh ? hi : xh;
+        axis_span(t->sy[k], g->origin[1], inv_width, radius, cb->iy, reach, &lo, &hi);
+        yl = lo < yl ? lo : yl;
+        yh = hi > yh ? hi : yh;
+        if (dim == 3) {
+            axis_span(t->sz[k], g->origin[2], inv_width, radius, cb->iz, reach, &lo, &hi);
+            zl = lo < zl ? lo : zl;
+            zh = hi > zh ? hi : zh;
+        }
+    }
     int n = 0;
     for (int dz = zl; dz <= zh; dz++)
         for (int dy = yl; dy <= yh; dy++) {
@@ -398,7 +411,7 @@ typedef struct {
     pair_test t;
     double radius, inv_width;
     int nrows;               /* rows stored per cell */
-    size_t *word;            /* np + 1 word offsets per sorted particle, or NULL: no bits */
+    size_t *cell_word;       /* ncells + 1 word offsets, or NULL: no bits */
     uint64_t *bits;
 } list_build;
 
@@ -409,19 +422,24 @@ static inline void load_position(const pair_test *t, size_t k, double xi[3])
     xi[2] = t->sz[k];
 }
 
-/* Pass 0: word[k + 1] = words of sorted particle k. */
+/* The rows of cell c, and the words of candidate bits each of its particles
+ * takes. */
+KERNEL int rows_of(const list_build *lb, size_t c, int dim, uint32_t *rows, size_t *nwords)
+{
+    cell_bounds cb;
+    bounds_of_cell(lb->g, c, lb->nrows, &cb);
+    int n = cell_rows(lb->g, &cb, c, &lb->t, lb->radius, lb->inv_width, dim, rows);
+    *nwords = words_per_particle(rows, n);
+    return n;
+}
+
+/* Pass 0: cell_word[c + 1] = words of the particles of cell c. */
 KERNEL void plan_cell(const list_build *lb, size_t c, int dim)
 {
-    const mf_grid *g = lb->g;
-    cell_bounds cb;
-    bounds_of_cell(g, c, lb->nrows, &cb);
     uint32_t rows[2 * MAX_ROWS];
-    for (size_t k = g->cell_start[c]; k < g->cell_start[c + 1]; k++) {
-        double xi[3];
-        load_position(&lb->t, k, xi);
-        int n = particle_rows(g, &cb, xi, lb->radius, lb->inv_width, dim, rows);
-        lb->word[k + 1] = words_per_particle(rows, n);
-    }
+    size_t nw = 0;
+    rows_of(lb, c, dim, rows, &nw);
+    lb->cell_word[c + 1] = nw * (lb->g->cell_start[c + 1] - lb->g->cell_start[c]);
 }
 
 /* Pass 1: start[i + 1] = number of neighbours of i; bits if kept; with sub
@@ -430,16 +448,18 @@ KERNEL void count_cell(const list_build *lb, size_t c, int dim, bool keep_bits, 
                        uint32_t *start, uint32_t *sstart)
 {
     const mf_grid *g = lb->g;
-    cell_bounds cb;
-    bounds_of_cell(g, c, lb->nrows, &cb);
     uint32_t rows[2 * MAX_ROWS];
-    for (size_t k = g->cell_start[c]; k < g->cell_start[c + 1]; k++) {
+    size_t nw = 0;
+    const int n = rows_of(lb, c, dim, rows, &nw);
+    const size_t k0 = g->cell_start[c];
+    for (size_t k = k0; k < g->cell_start[c + 1]; k++) {
         double xi[3];
         load_position(&lb->t, k, xi);
-        int n = particle_rows(g, &cb, xi, lb->radius, lb->inv_width, dim, rows);
         size_t shits = 0;
         size_t hits = test_candidates(&lb->t, rows, n, xi, dim, keep_bits,
-                                      keep_bits ? lb->bits + lb->word[k] : NULL, sub, &shits);
+                                      keep_bits ? lb->bits + lb->cell_word[c] + (k - k0) * nw
+                                                : NULL,
+                                      sub, &shits);
         start[g->order[k] + 1] = (uint32_t)(hits - 1); /* minus the particle itself */
         if (sub)
             sstart[g->order[k] + 1] = (uint32_t)(shits - 1);
@@ -452,25 +472,25 @@ KERNEL void fill_cell(const list_build *lb, size_t c, int dim, const uint32_t *s
                       uint32_t *jlist, const uint32_t *sstart, uint32_t *sjlist)
 {
     const mf_grid *g = lb->g;
-    cell_bounds cb;
-    bounds_of_cell(g, c, lb->nrows, &cb);
     uint32_t rows[2 * MAX_ROWS];
-    for (size_t k = g->cell_start[c]; k < g->cell_start[c + 1]; k++) {
+    size_t nw = 0;
+    const int n = rows_of(lb, c, dim, rows, &nw);
+    size_t row_bit[MAX_ROWS + 1];
+    row_bit_offsets(rows, n, row_bit);
+    const size_t k0 = g->cell_start[c];
+    for (size_t k = k0; k < g->cell_start[c + 1]; k++) {
         double xi[3];
         load_position(&lb->t, k, xi);
-        int n = particle_rows(g, &cb, xi, lb->radius, lb->inv_width, dim, rows);
         const uint32_t i = g->order[k];
         uint32_t *out = jlist + start[i];
-        if (lb->word) {
-            size_t row_bit[MAX_ROWS + 1];
-            row_bit_offsets(rows, n, row_bit);
-            const size_t nw = lb->word[k + 1] - lb->word[k];
+        if (lb->cell_word) {
+            const uint64_t *words = lb->bits + lb->cell_word[c] + (k - k0) * nw;
             if (sstart)
-                decode_bits(lb->bits + lb->word[k], nw, rows, row_bit, g->order, k, out, true,
-                            &lb->t, xi, dim, sjlist + sstart[i]);
+                decode_bits(words, nw, rows, row_bit, g->order, k, out, true, &lb->t, xi, dim,
+                            sjlist + sstart[i]);
             else
-                decode_bits(lb->bits + lb->word[k], nw, rows, row_bit, g->order, k, out, false,
-                            &lb->t, xi, dim, NULL);
+                decode_bits(words, nw, rows, row_bit, g->order, k, out, false, &lb->t, xi, dim,
+                            NULL);
         } else {
             retest_candidates(&lb->t, rows, n, g->order, k, xi, dim, lb->t.r2, out);
             if (sstart)
@@ -523,7 +543,7 @@ static void count_pass(const list_build *lb, uint32_t *start, uint32_t *sstart)
 {
     const size_t ncells = lb->g->ncells;
     const int dim = lb->g->dim;
-    const bool keep_bits = lb->word != NULL, sub = sstart != NULL;
+    const bool keep_bits = lb->cell_word != NULL, sub = sstart != NULL;
 #pragma omp parallel for schedule(dynamic, 32)
     for (size_t c = 0; c < ncells; c++)
         count_cell_as(lb, c, dim, keep_bits, sub, start, sstart);
@@ -543,29 +563,29 @@ static void fill_pass(const list_build *lb, const uint32_t *start, uint32_t *jli
     }
 }
 
-/* Lay out the candidate bits: word offsets per sorted particle at the start
- * of the scratch, the bits after them. Leaves lb->word NULL (no bits) when
+/* Lay out the candidate bits: word offsets per cell at the start of the
+ * scratch, the bits after them. Leaves lb->cell_word NULL (no bits) when
  * they would exceed MAX_BIT_WORDS_PER_PARTICLE on average. */
 static int plan_bits(mf_nlist *nl, list_build *lb)
 {
-    const size_t np = lb->g->np;
-    lb->word = NULL;
+    const size_t np = lb->g->np, ncells = lb->g->ncells;
+    lb->cell_word = NULL;
     lb->bits = NULL;
     /* Grow only: the bits that follow the offsets need the space again. */
-    if (!nl->work || nl->work_bytes < (np + 1) * sizeof(size_t))
-        MF_CALL(ensure_work(nl, (np + 1) * sizeof(size_t)));
-    size_t *word = nl->work;
-    lb->word = word;
+    if (!nl->work || nl->work_bytes < (ncells + 1) * sizeof(size_t))
+        MF_CALL(ensure_work(nl, (ncells + 1) * sizeof(size_t)));
+    size_t *cell_word = nl->work;
+    lb->cell_word = cell_word;
     plan_pass(lb);
-    word[0] = 0;
-    for (size_t k = 0; k < np; k++)
-        word[k + 1] += word[k];
-    const size_t total = word[np];
+    cell_word[0] = 0;
+    for (size_t c = 0; c < ncells; c++)
+        cell_word[c + 1] += cell_word[c];
+    const size_t total = cell_word[ncells];
     if (total > MAX_BIT_WORDS_PER_PARTICLE * np) {
-        lb->word = NULL;
+        lb->cell_word = NULL;
         return 0;
     }
-    const size_t need = (np + 1) * sizeof(size_t) + total * sizeof(uint64_t);
+    const size_t need = (ncells + 1) * sizeof(size_t) + total * sizeof(uint64_t);
     if (nl->work_bytes < need) { /* grow, keeping the offsets just planned */
         size_t cap = with_headroom(need);
         void *grown = realloc(nl->work, cap);
@@ -574,10 +594,10 @@ static int plan_bits(mf_nlist *nl, list_build *lb)
                             cap);
         nl->work = grown;
         nl->work_bytes = cap;
-        word = nl->work;
-        lb->word = word;
+        cell_word = nl->work;
+        lb->cell_word = cell_word;
     }
-    lb->bits = (uint64_t *)(word + np + 1);
+    lb->bits = (uint64_t *)(cell_word + ncells + 1);
     return 0;
 }
 

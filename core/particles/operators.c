@@ -63,15 +63,21 @@ static inline bool min_pair(void *acc, const void *ctx, const mf_pair *pr)
     return true;
 }
 
-static inline bool grad_pair(void *acc, const void *ctx, const mf_pair *pr)
+/* The pair coefficient c_ij of the gradient: 1, a constant, or 1/rho_ij
+ * (a literal at the call sites: each compiles to its own loop). */
+enum { COEF_ONE, COEF_CONSTANT, COEF_RHO };
+
+static inline bool grad_pair(void *acc, const void *ctx, const mf_pair *pr, int mode)
 {
     const grad_ctx *c = ctx;
     const mf_gradient_opts *o = c->o;
     grad_acc *a = acc;
     if (pr->len <= 0.0)
         return true; /* coincident particles carry no direction */
-    const double cij = o->rho ? mf_inv_rho_pair(o->rho[pr->i], o->rho[pr->j], o->rho_average)
-                              : o->coef;
+    const double cij = mode == COEF_RHO ? mf_inv_rho_pair(o->rho[pr->i], o->rho[pr->j],
+                                                          o->rho_average)
+                       : mode == COEF_CONSTANT ? o->coef
+                                               : 1.0;
     const double s =
         mf_gradient_term(o->f[pr->j] - a->fhat, cij, mf_weight(pr->len, c->v->radius), pr->len);
     a->g[0] += s * pr->r[0];
@@ -80,38 +86,53 @@ static inline bool grad_pair(void *acc, const void *ctx, const mf_pair *pr)
     return true;
 }
 
-/* Pairs a row gathers for its two passes; a row with more runs both passes
- * over the list. */
-#define GATHER 96
+static inline bool grad_pair_one(void *acc, const void *ctx, const mf_pair *pr)
+{
+    return grad_pair(acc, ctx, pr, COEF_ONE);
+}
 
-static void grad_row(const void *ctx, size_t i)
+static inline bool grad_pair_constant(void *acc, const void *ctx, const mf_pair *pr)
+{
+    return grad_pair(acc, ctx, pr, COEF_CONSTANT);
+}
+
+static inline bool grad_pair_rho(void *acc, const void *ctx, const mf_pair *pr)
+{
+    return grad_pair(acc, ctx, pr, COEF_RHO);
+}
+
+static inline void grad_row(const void *ctx, size_t i, int mode)
 {
     const grad_ctx *c = ctx;
     const mf_gradient_opts *o = c->o;
     grad_acc a = {o->f[i], {0.0, 0.0, 0.0}};
-    const bool use_min = o->use_min && !(o->own_reference && o->own_reference[i]);
-    mf_pair buf[GATHER];
-    const size_t n = use_min ? mf_pairs_gather(c->v, i, c->jmask, buf, GATHER) : GATHER + 1;
-    if (n <= GATHER) {
-        for (size_t k = 0; k < n; k++)
-            min_pair(&a.fhat, c, &buf[k]);
-        for (size_t k = 0; k < n; k++)
-            grad_pair(&a, c, &buf[k]);
-    } else {
-        if (use_min)
-            mf_pairs_row(c->v, i, c->jmask, min_pair, c, &a.fhat);
-        mf_pairs_row(c->v, i, c->jmask, grad_pair, c, &a);
-    }
+    if (o->use_min && !(o->own_reference && o->own_reference[i]))
+        mf_pairs_row_r2(c->v, i, c->jmask, min_pair, c, &a.fhat);
+    if (mode == COEF_RHO)
+        mf_pairs_row(c->v, i, c->jmask, grad_pair_rho, c, &a);
+    else if (mode == COEF_CONSTANT)
+        mf_pairs_row(c->v, i, c->jmask, grad_pair_constant, c, &a);
+    else
+        mf_pairs_row(c->v, i, c->jmask, grad_pair_one, c, &a);
     c->out[3 * i + 0] = c->coef * a.g[0];
     c->out[3 * i + 1] = c->coef * a.g[1];
     c->out[3 * i + 2] = c->coef * a.g[2];
 }
 
+static void grad_row_one(const void *ctx, size_t i) { grad_row(ctx, i, COEF_ONE); }
+static void grad_row_constant(const void *ctx, size_t i) { grad_row(ctx, i, COEF_CONSTANT); }
+static void grad_row_rho(const void *ctx, size_t i) { grad_row(ctx, i, COEF_RHO); }
+
 void mf_gradient_ex(const mf_pairs *v, const mf_kernel *k, const mf_gradient_opts *o,
                     const uint8_t *imask, const uint8_t *jmask, double *out)
 {
     const grad_ctx c = {v, o, jmask, k->dim / k->n0, out};
-    mf_pairs_each(v, imask, grad_row, &c);
+    if (o->rho)
+        mf_pairs_each(v, imask, grad_row_rho, &c);
+    else if (o->coef == 1.0)
+        mf_pairs_each(v, imask, grad_row_one, &c);
+    else
+        mf_pairs_each(v, imask, grad_row_constant, &c);
 }
 
 void mf_gradient(const mf_pairs *v, const mf_kernel *k, const double *f, bool use_min,

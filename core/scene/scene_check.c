@@ -41,7 +41,7 @@ int mf_scene_check_overlap(const mf_sim *sim)
     overlap_acc a = {0, 0, 0};
     /* Every particle: the scene has no halos yet. */
     for (size_t i = 0; rc == 0 && i < p->n; i++)
-        mf_pairs_row(&v, i, NULL, overlap_pair, NULL, &a);
+        mf_pairs_row_r2(&v, i, NULL, overlap_pair, NULL, &a);
     mf_neighbours_destroy(nb);
     MF_CALL(rc);
     if (a.pairs == 0)

@@ -58,7 +58,7 @@ int mf_front_of_particles(const mf_particles *fluid, double l0, double back_wall
         rc = mf_neighbours_pairs(nb, fluid, h, &v);
     for (size_t i = 0; rc == 0 && i < fluid->n; i++) {
         int count = 0;
-        mf_pairs_row(&v, i, NULL, count_two, NULL, &count);
+        mf_pairs_row_r2(&v, i, NULL, count_two, NULL, &count);
         if (count >= 2 && fluid->pos[3 * i] - back_wall > *z)
             *z = fluid->pos[3 * i] - back_wall;
     }

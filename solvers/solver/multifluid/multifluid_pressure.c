@@ -61,7 +61,7 @@ static int set_heavy_unknowns(multifluid_data *d, const mf_sim *sim, size_t *cou
             if (p->kind[i] == MF_FLUID)
                 in = d->heavy_mask[i];
             else
-                mf_pairs_row(&v, i, NULL, heavy_pair, d, &in);
+                mf_pairs_row_r2(&v, i, NULL, heavy_pair, d, &in);
         }
         m->in_ppe[i] = in;
         *count += in;
