@@ -199,6 +199,7 @@ int mf_app_setup(mf_app *app)
     mf_log_init(&app->log, stdout, app->opt.log_level);
     sim->log = &app->log;
     sim->reg = app->reg;
+    MF_CALL(mf_neighbours_create(&sim->neighbours));
     MF_CALL(mf_case_read(app->opt.case_dir, &app->cs));
     MF_CALL(mf_app_check_output(app));
     MF_CALL(mf_app_load_case_libs(app));
@@ -283,6 +284,8 @@ void mf_app_teardown(mf_app *app)
     mf_emitters_destroy(app->sim.emitters);
     app->sim.emitters = NULL;
     mf_particles_destroy(app->sim.p);
+    mf_neighbours_destroy(app->sim.neighbours);
+    app->sim.neighbours = NULL;
     mf_case_free(&app->cs);
 }
 

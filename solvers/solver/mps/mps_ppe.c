@@ -27,22 +27,31 @@
 #include "mf_run.h"
 #include "mps.h"
 
+/* Grow *ptr to count elements, keeping the old block when that fails. */
+static int grow(void **ptr, size_t count, size_t elem)
+{
+    void *grown = realloc(*ptr, count * elem);
+    if (!grown)
+        return MF_ERR_MEMORY;
+    *ptr = grown;
+    return 0;
+}
+
+/* Room for rows unknowns and nnz entries; 1/16 headroom (the counts drift
+ * little from step to step, and the matrix is the largest array of a run). */
 static int reserve_system(mps_data *d, size_t rows, size_t nnz)
 {
     if (rows + 1 > d->cap_rows) {
-        size_t cap = rows + rows / 4 + 64;
-        d->A.rowptr = realloc(d->A.rowptr, (cap + 1) * sizeof *d->A.rowptr);
-        d->rhs = realloc(d->rhs, cap * sizeof *d->rhs);
-        d->x = realloc(d->x, cap * sizeof *d->x);
-        if (!d->A.rowptr || !d->rhs || !d->x)
+        size_t cap = rows + rows / 16 + 64;
+        if (grow((void **)&d->A.rowptr, cap + 1, sizeof *d->A.rowptr) ||
+            grow((void **)&d->rhs, cap, sizeof *d->rhs) || grow((void **)&d->x, cap, sizeof *d->x))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu pressure unknowns", rows);
         d->cap_rows = cap;
     }
     if (nnz > d->cap_nnz) {
-        size_t cap = nnz + nnz / 4 + 64;
-        d->A.col = realloc(d->A.col, cap * sizeof *d->A.col);
-        d->A.val = realloc(d->A.val, cap * sizeof *d->A.val);
-        if (!d->A.col || !d->A.val)
+        size_t cap = nnz + nnz / 16 + 64;
+        if (grow((void **)&d->A.col, cap, sizeof *d->A.col) ||
+            grow((void **)&d->A.val, cap, sizeof *d->A.val))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu matrix entries", nnz);
         d->cap_nnz = cap;
     }
@@ -89,24 +98,115 @@ static size_t regularise_closed_groups(mps_data *d, const uint8_t *touches_diric
     return fixed;
 }
 
+/* One PPE row (the header's A_ii, A_ij, rhs_i) from the pair engine's
+ * assemble sink: the coefficient kernel is c w_ij (1/rho_ij), a Dirichlet
+ * neighbour's known pressure goes to the right-hand side. */
+typedef struct ppe_ctx {
+    mps_data *d;
+    const mf_sim *sim;
+    mf_pairs v;
+    mf_rows rows;
+    double c, dt, rho, n0, re;
+    const double *rho_p, *pd, *n, *pressure;
+    int avg;
+    uint8_t *touches;
+} ppe_ctx;
+
+typedef struct ppe_acc {
+    double known;   /* sum of c w_ij p_j / rho_ij over the Dirichlet neighbours */
+    bool touches;   /* a Dirichlet neighbour with w > 0 */
+} ppe_acc;
+
+static inline double ppe_coef(const void *ctx, const mf_pair *pr)
+{
+    const ppe_ctx *c = ctx;
+    double cw = c->c * mf_weight(pr->len, c->re);
+    if (c->rho_p)
+        cw *= mf_inv_rho_pair(c->rho_p[pr->i], c->rho_p[pr->j], c->avg);
+    return cw;
+}
+
+static inline void ppe_known(void *acc, const void *ctx, const mf_pair *pr, double a)
+{
+    const ppe_ctx *c = ctx;
+    ppe_acc *k = acc;
+    if (mf_weight(pr->len, c->re) > 0) {
+        k->touches = true;
+        if (c->pd)
+            k->known += a * c->pd[pr->j];
+    }
+}
+
+/* false: a fluid particle with no non-dummy neighbour (reported by the caller). */
+static bool ppe_row(const void *ctx, size_t i, size_t r)
+{
+    const ppe_ctx *c = ctx;
+    mps_data *d = c->d;
+    ppe_acc acc = {0.0, false};
+    const size_t diag = c->rows.rowptr[r];
+    const double sum = mf_pairs_row_assemble(&c->v, i, d->not_dummy, NULL, ppe_coef, ppe_known,
+                                             c, &acc, &c->rows, r);
+    if (!(sum > 0) && d->is_fluid[i])
+        return false;
+    const double dt2 = c->dt * c->dt;
+    /* n* - n0, or against a per-particle reference (mps_data.n_offset) */
+    const double dn = d->n_offset ? c->n[i] - c->n0 - d->n_offset[i] : c->n[i] - c->n0;
+    double *val = d->A.val;
+    if (c->rho_p) {
+        val[diag] = sum + d->s.compressibility / dt2;
+        d->rhs[r] = d->s.relaxation / dt2 * dn / c->n0;
+    } else {
+        val[diag] = sum + d->s.compressibility * c->rho / dt2;
+        d->rhs[r] = d->s.relaxation * c->rho / dt2 * dn / c->n0;
+    }
+    if (c->pd)
+        d->rhs[r] += acc.known;
+    c->touches[r] = acc.touches;
+    if (!(sum > 0) && d->s.compressibility <= 0) {
+        /* A wall particle with only dummies within re: no equation
+         * couples it, so it takes p = 0 (a zero row is singular). */
+        val[diag] = c->c;
+        d->rhs[r] = 0;
+        c->touches[r] = 1;
+    }
+    if (d->s.compressibility > 0)
+        c->touches[r] = 1;
+    d->x[r] = c->pressure[i]; /* warm start from the last step */
+    return true;
+}
+
+static size_t ppe_count(const void *ctx, size_t i)
+{
+    const ppe_ctx *c = ctx;
+    return mf_pairs_row_count(&c->v, i, c->d->not_dummy, NULL, c, c->rows.col_of);
+}
+
+/* Between the count and the fill: room for the entries. */
+static int ppe_sized(void *ctx, size_t nnz)
+{
+    ppe_ctx *c = ctx;
+    MF_CALL(reserve_system(c->d, c->d->A.nrows, nnz));
+    c->rows.col = c->d->A.col;
+    c->rows.val = c->d->A.val;
+    c->rows.rowptr = c->d->A.rowptr;
+    return 0;
+}
+
 int mps_assemble_ppe(mps_data *d, const mf_sim *sim, double dt)
 {
     double t0 = mf_wall_seconds();
     const mf_particles *p = sim->p;
-    const mf_nlist *nl = d->k_lap.re >= d->nl_max.radius ? &d->nl_max : &d->nl_lap;
-    const double *n = mf_particles_fd(p, d->f_number_density);
-    size_t nrows = 0, nnz = 0;
-    for (size_t i = 0; i < p->n_owned; i++) {
+    size_t nrows = 0;
+    for (size_t i = 0; i < p->n_owned; i++)
         d->row[i] = d->in_ppe[i] ? (long)nrows++ : -1;
-        if (d->in_ppe[i]) {
-            nnz++;
-            for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++)
-                nnz += d->in_ppe[nl->j[k]];
-        }
-    }
     if (d->periodic) /* an image is its owner's unknown */
         mps_periodic_sync(d, p, d->row, sizeof *d->row);
-    MF_CALL(reserve_system(d, nrows, nnz));
+    if (p->global_offset + (int64_t)nrows > MF_CSR_MAX_GLOBAL)
+        return MF_ERROR(MF_ERR_INPUT,
+                        "%zu pressure unknowns: the matrix's columns are 32-bit (hypre's "
+                        "HYPRE_BigInt), at most %d in all",
+                        nrows, MF_CSR_MAX_GLOBAL);
+    MF_CALL(reserve_system(d, nrows, 0));
     uint8_t *touches = calloc(nrows ? nrows : 1, 1);
     if (!touches)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory");
@@ -114,77 +214,44 @@ int mps_assemble_ppe(mps_data *d, const mf_sim *sim, double dt)
     A->nrows = nrows;
     A->row_offset = p->global_offset;
     A->nglobal = (int64_t)nrows; /* one rank */
-    const double c = 2.0 * d->k_lap.dim / (d->k_lap.lambda * d->k_lap.n0);
-    const double rho = sim->fluid[0].rho, n0 = d->k_nd.n0, re = nl->radius;
-    const double *rho_p = d->rho, *pd = d->p_dirichlet;
-    const int avg = d->rho_average;
-    const double *pressure = mf_particles_fd(p, d->f_pressure);
-    size_t pos = 0;
-    for (size_t i = 0; i < p->n_owned; i++) {
-        if (!d->in_ppe[i])
-            continue;
-        size_t r = (size_t)d->row[i];
-        A->rowptr[r] = pos;
-        size_t diag = pos++;
-        A->col[diag] = A->row_offset + (int64_t)r;
-        double sum = 0, known = 0;
-        for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
-            size_t j = nl->j[k];
-            if (!d->not_dummy[j])
-                continue;
-            double dx = p->pos[3 * j] - p->pos[3 * i], dy = p->pos[3 * j + 1] - p->pos[3 * i + 1],
-                   dz = p->pos[3 * j + 2] - p->pos[3 * i + 2];
-            double w = mf_weight(sqrt(dx * dx + dy * dy + dz * dz), re);
-            double cw = c * w;
-            if (rho_p)
-                cw *= mps_inv_rho_pair(rho_p[i], rho_p[j], avg);
-            sum += cw;
-            if (d->in_ppe[j]) {
-                A->col[pos] = A->row_offset + d->row[j];
-                A->val[pos++] = -cw;
-            } else if (w > 0) {
-                touches[r] = 1; /* a Dirichlet neighbour */
-                if (pd)
-                    known += cw * pd[j];
-            }
-        }
-        if (!(sum > 0) && d->is_fluid[i]) {
-            /* n* counts dummy particles, the Laplacian does not: a fluid
-             * particle with only dummies within re is inside a wall, and its
-             * row would be zero (BoomerAMG stops on the singular system).
-             * Seen on a mesh wall, which the run's watch does not check. */
-            int rc = MF_ERROR(MF_ERR_NUMERIC,
-                              "unstable (throughWall) at time %g, step %ld: fluid particle id "
-                              "%lld at (%g %g %g) has only dummy particles within re: it is "
-                              "inside a wall",
-                              sim->time, sim->step, (long long)p->id[i], p->pos[3 * i],
-                              p->pos[3 * i + 1], p->pos[3 * i + 2]);
-            free(touches);
-            return rc;
-        }
-        /* n* - n0, or against a per-particle reference (mps_data.n_offset) */
-        const double dn = d->n_offset ? n[i] - n0 - d->n_offset[i] : n[i] - n0;
-        if (rho_p) {
-            A->val[diag] = sum + d->s.compressibility / (dt * dt);
-            d->rhs[r] = d->s.relaxation / (dt * dt) * dn / n0;
-        } else {
-            A->val[diag] = sum + d->s.compressibility * rho / (dt * dt);
-            d->rhs[r] = d->s.relaxation * rho / (dt * dt) * dn / n0;
-        }
-        if (pd)
-            d->rhs[r] += known;
-        if (!(sum > 0) && d->s.compressibility <= 0) {
-            /* A wall particle with only dummies within re: no equation
-             * couples it, so it takes p = 0 (a zero row is singular). */
-            A->val[diag] = c;
-            d->rhs[r] = 0;
-            touches[r] = 1;
-        }
-        if (d->s.compressibility > 0)
-            touches[r] = 1;
-        d->x[r] = pressure[i]; /* warm start from the last step */
+    ppe_ctx c = {
+        .d = d,
+        .sim = sim,
+        .rows = {d->row, A->row_offset, A->rowptr, A->col, A->val},
+        .c = 2.0 * d->k_lap.dim / (d->k_lap.lambda * d->k_lap.n0),
+        .dt = dt,
+        .rho = sim->fluid[0].rho,
+        .n0 = d->k_nd.n0,
+        .rho_p = d->rho,
+        .pd = d->p_dirichlet,
+        .n = mf_particles_fd(p, d->f_number_density),
+        .pressure = mf_particles_fd(p, d->f_pressure),
+        .avg = d->rho_average,
+        .touches = touches,
+    };
+    int rc = mps_pairs(d, sim, d->h_lap, &c.v);
+    c.re = c.v.radius;
+    size_t failed = SIZE_MAX;
+    if (rc == 0)
+        rc = mf_pairs_assemble(&c.v, d->row, A->rowptr, nrows, ppe_count, ppe_sized, ppe_row, &c,
+                               &failed);
+    if (rc == 0 && failed != SIZE_MAX) {
+        /* n* counts dummy particles, the Laplacian does not: a fluid
+         * particle with only dummies within re is inside a wall, and its
+         * row would be zero (BoomerAMG stops on the singular system).
+         * Seen on a mesh wall, which the run's watch does not check. */
+        const size_t i = failed;
+        rc = MF_ERROR(MF_ERR_NUMERIC,
+                      "unstable (throughWall) at time %g, step %ld: fluid particle id "
+                      "%lld at (%g %g %g) has only dummy particles within re: it is "
+                      "inside a wall",
+                      sim->time, sim->step, (long long)p->id[i], p->pos[3 * i],
+                      p->pos[3 * i + 1], p->pos[3 * i + 2]);
     }
-    A->rowptr[nrows] = pos;
+    if (rc != 0) {
+        free(touches);
+        return mf_error_trace(rc, __FILE__, __LINE__, __func__);
+    }
     size_t closed = regularise_closed_groups(d, touches);
     free(touches);
     if (closed)
