@@ -42,6 +42,12 @@ PY
 
 fresh; add_force "nanAt 0.02;"
 trip "NaN injected" nonFinite -endTime 0.1
+grep -q "force 'fault' gave" "$dir/log" || fail "NaN injected: the force is not named"
+
+# A linear solve that returns a NaN: mf_pressure_solve's check names it.
+fresh; add_force "solveNanAt 0.02;"
+trip "NaN from the pressure solve" nonFinite -endTime 0.1
+grep -q "PCG_BoomerAMG returned a non-finite p" "$dir/log" || fail "NaN from the solve: the solve is not named"
 
 fresh; add_force "pushAt 0.02; push (0 -1e7 0);"
 printf 'watch { energyTolerance 1e6; }\n' >> "$dir/case/system/controlDict"

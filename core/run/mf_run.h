@@ -12,6 +12,7 @@
 
 #include <stdbool.h>
 
+#include "mf_clock.h" /* mf_wall_seconds, mf_cpu_seconds */
 #include "mf_modules.h"
 #include "mf_sim.h"
 #include "mf_watch.h"
@@ -47,9 +48,6 @@ typedef struct mf_run {
  * write_initial is set (a fresh start; a restart has it already). */
 int mf_run_loop(mf_run *run, bool write_initial);
 
-/* Seconds since an arbitrary origin (monotonic) and process CPU seconds. */
-double mf_wall_seconds(void);
-double mf_cpu_seconds(void);
 /* Peak resident memory of this process, bytes. */
 size_t mf_peak_memory(void);
 

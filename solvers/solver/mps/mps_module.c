@@ -2,7 +2,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "force/forces.h"
 #include "mf_error.h"
 #include "mps.h"
 
@@ -64,8 +63,16 @@ int mps_create_data(const mps_settings *s, mf_sim *sim, const mf_dict *solver_di
                                        &d->f_number_density));
     MF_CALL(mf_particles_request_field(sim->p, "Flags", 1, MF_FIELD_INT32, true, &d->f_flags));
     MF_CALL(create_pressure(d, sim, solver_dict));
-    if (strcmp(s->viscosity, "implicit") == 0)
-        MF_CALL(mps_viscosity_create(d, sim));
+    if (strcmp(s->viscosity, "implicit") == 0) {
+        MF_CALL(mps_viscosity_create(d, sim, solver_dict));
+    } else if (solver_dict && mf_dict_find(solver_dict, "viscosity")) {
+        char where[512];
+        return MF_ERROR(MF_ERR_INPUT,
+                        "%s: a viscosity { solver ...; } dictionary, but the viscosity is "
+                        "explicit: set viscosity implicit; in the solver's Coeffs, or remove it",
+                        mf_loc_str(mf_dict_find(solver_dict, "viscosity")->loc, where,
+                                   sizeof where));
+    }
     MF_CALL(mps_reserve(d, sim->p->n));
     const mf_kernel *ks[3] = {&d->k_nd, &d->k_grad, &d->k_lap};
     const char *names[3] = {"number density", "gradient", "Laplacian"};
@@ -144,14 +151,6 @@ static int mps_step(void *data, mf_sim *sim, double dt)
 
 static void mps_destroy(void *data) { mps_destroy_data(data); }
 
-/* The forces' own limit (the capillary step of surfaceTension), if any. */
-static int mps_stable_dt(void *data, const mf_sim *sim, double *dt)
-{
-    (void)data;
-    *dt = mf_forces_stable_dt(sim);
-    return 0;
-}
-
 static void mps_report(void *data, const mf_sim *sim, mf_log *log)
 {
     const mps_data *d = data;
@@ -181,6 +180,6 @@ const mf_solver_ops mf_solver_MPS = {
     .create = mps_create,
     .step = mps_step,
     .destroy = mps_destroy,
-    .stable_dt = mps_stable_dt,
+    .stable_dt = NULL, /* the forces' limits are the time loop's (mf_stable_dt) */
     .report = mps_report,
 };

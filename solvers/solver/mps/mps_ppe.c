@@ -243,13 +243,8 @@ int mps_solve_ppe(mps_data *d, mf_sim *sim)
 {
     double t0 = mf_wall_seconds();
     mf_particles *p = sim->p;
-    int rc = d->pressure_ops->solve(d->pressure.data, &d->A, d->rhs, d->x, &d->last);
-    mf_log_printf(sim->log, MF_LOG_STEP,
-                  "%s:  Solving for %s, Initial residual = %g, Final residual = %g, No "
-                  "Iterations %d\n",
-                  d->pressure.info->name, d->solve_name ? d->solve_name : "p",
-                  d->last.initial_residual, d->last.final_residual,
-                  d->last.iterations);
+    int rc = mf_pressure_solve(&d->pressure, sim, d->solve_name ? d->solve_name : "p", &d->A,
+                               d->rhs, d->x, &d->last);
     sim->pressure_iterations += d->last.iterations;
     d->solves++;
     d->t_setup += d->last.setup_seconds;

@@ -126,15 +126,10 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
     const double nu = sim->fluid[0].nu;
     memset(d->acc, 0, 3 * p->n * sizeof *d->acc);
     sim->neighbours = &d->nl_max; /* at r^n: forces that need neighbours use it */
-    for (size_t k = 0; k < sim->nforces; k++) {
-        const mf_force_ops *ops = (const mf_force_ops *)sim->forces[k].info;
-        int rc = ops->accumulate(sim->forces[k].data, sim, d->acc);
-        if (rc != 0) {
-            sim->neighbours = NULL;
-            return mf_error_trace(rc, __FILE__, __LINE__, __func__);
-        }
-    }
+    int rc = mf_force_accumulate(sim, d->acc);
     sim->neighbours = NULL;
+    if (rc != 0)
+        return mf_error_trace(rc, __FILE__, __LINE__, __func__);
     if (d->visc) { /* viscosity implicit: u* = (I - dt nu lap)^-1 (u + dt a), r* = r + dt u* */
         MF_CALL(mps_viscosity_implicit(d, sim, dt));
     } else if (d->mu) {
