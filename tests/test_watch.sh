@@ -85,6 +85,13 @@ trip "pressure solve not converging" pressureSolve -endTime 0.1
 fresh
 "$mpsflow" -case "$dir/case" -quiet -endTime 0.3 > "$dir/log" 2>&1 && grep -q "^status *completed;" "$dir/case/output/runSummary" &&
     { echo "ok   stable run: completed with the watch on"; passed=$((passed + 1)); } || fail "stable run did not complete"
+# The watch makes no force pass of its own: one call of each force per attempt.
+steps=$(sed -n 's/^Steps \([0-9]*\) (retried \([0-9]*\)).*/\1 \2/p' "$dir/log")
+calls=$(sed -n 's/^Force gravity: \([0-9]*\) calls.*/\1/p' "$dir/log")
+set -- $steps
+[ -n "$calls" ] && [ "$calls" -eq $(($1 + $2)) ] &&
+    { echo "ok   one force pass a step: gravity ran $calls times in $1 steps ($2 retried)"; passed=$((passed + 1)); } ||
+    fail "force passes: gravity ran '$calls' times in '$steps' steps (retried)"
 
 echo "$passed passed, $failed failed"
 [ $failed -eq 0 ]

@@ -179,6 +179,13 @@ int mf_cmd_run(mf_app *app)
     const mf_solver_ops *ops = (const mf_solver_ops *)app->solver.info;
     if (ops->report)
         ops->report(app->solver.data, &app->sim, &app->log);
+    /* What the calling wrappers counted (mf_modules.h). */
+    mf_log_printf(&app->log, MF_LOG_QUIET, "Solver %s: %ld steps, %.3f s\n",
+                  app->solver.info->name, app->solver.calls, app->solver.seconds);
+    for (size_t k = 0; k < app->sim.nforces; k++)
+        mf_log_printf(&app->log, MF_LOG_QUIET, "Force %s: %ld calls, %.3f s\n",
+                      app->sim.forces[k].info->name, app->sim.forces[k].calls,
+                      app->sim.forces[k].seconds);
     mf_log_printf(&app->log, MF_LOG_QUIET,
                   "\nSteps %ld (retried %ld), snapshots %d, wall time %.2f s, peak memory %.1f "
                   "MB\n",
