@@ -54,6 +54,18 @@ typedef struct mf_csr {
     double *val;      /* rowptr[nrows] */
 } mf_csr;
 
+/* Names of the rows of a system, for a pressure module that reuses work
+ * (an AMG hierarchy) across solves whose rows change: row r is unknown
+ * slot[r] (MPS: the index of its particle), and two solves with the same
+ * nslots and epoch mean the same unknown by the same slot (the caller
+ * changes epoch when the slots change meaning: particles reordered, added
+ * or removed). */
+typedef struct mf_rows {
+    const int64_t *slot; /* one per local row, distinct, in [0, nslots) */
+    int64_t nslots;
+    uint64_t epoch;
+} mf_rows;
+
 typedef struct mf_solve_report {
     int iterations;
     double initial_residual; /* ||b - A x0|| / ||b|| */
@@ -69,6 +81,11 @@ typedef struct mf_pressure_ops {
      * MF_RETRY when not converged within the iteration limit. */
     int (*solve)(void *data, const mf_csr *A, const double *b, double *x, mf_solve_report *rep);
     void (*destroy)(void *data);
+    /* ABI 2, optional: solve with the rows named (see mf_rows), so that the
+     * module may keep its preconditioner across solves of changing matrices.
+     * Absent: mf_pressure_solve calls solve. */
+    int (*solve_rows)(void *data, const mf_csr *A, const mf_rows *rows, const double *b,
+                      double *x, mf_solve_report *rep);
 } mf_pressure_ops;
 
 /* ---- convection scheme (MPS-MAFL Eulerian phase) -------------------------- */
@@ -213,6 +230,10 @@ int mf_forces_surface_pressure(const mf_sim *sim, const uint8_t *dirichlet, doub
  * filled, for the caller to name what it was solving. */
 int mf_pressure_solve(mf_module *m, const mf_sim *sim, const char *field, const mf_csr *A,
                       const double *b, double *x, mf_solve_report *rep);
+/* The same with the rows named (rows may be NULL: as mf_pressure_solve). */
+int mf_pressure_solve_rows(mf_module *m, const mf_sim *sim, const char *field, const mf_csr *A,
+                           const mf_rows *rows, const double *b, double *x,
+                           mf_solve_report *rep);
 
 /* One step of the solver module: the time, the fault-injection point. */
 int mf_solver_step(mf_module *solver, mf_sim *sim, double dt);

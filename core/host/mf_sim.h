@@ -113,6 +113,11 @@ typedef struct mf_sim {
     /* Inlets, outlets and nozzles (mf_emitter.h), applied by the time loop
      * before each step; NULL when the case has none. */
     struct mf_emitters *emitters;
+    /* Snapshots written so far by this process. A module that keeps work
+     * from step to step (an AMG hierarchy) starts afresh when it changes:
+     * a run restarted from a snapshot then repeats the straight run bit for
+     * bit, both having started afresh at that step. */
+    long snapshot_epoch;
     /* This step's force accelerations (mf_force_accumulate). */
     mf_force_record forces_record;
     /* Tests only: a hook the calling wrappers offer their results to (no

@@ -41,7 +41,9 @@ size_t mf_ops_size(mf_module_kind kind, int abi)
         return 0;
     switch (kind) {
     case MF_KIND_SOLVER: return sizeof(mf_solver_ops);
-    case MF_KIND_PRESSURE: return sizeof(mf_pressure_ops);
+    /* ABI 2 added solve_rows. */
+    case MF_KIND_PRESSURE:
+        return abi >= 2 ? sizeof(mf_pressure_ops) : offsetof(mf_pressure_ops, solve_rows);
     case MF_KIND_CONVECTION: return sizeof(mf_convection_ops);
     /* ABI 2 added flags and the slots after it. */
     case MF_KIND_FORCE: return abi >= 2 ? sizeof(mf_force_ops) : offsetof(mf_force_ops, flags);

@@ -139,13 +139,21 @@ int mf_forces_surface_pressure(const mf_sim *sim, const uint8_t *dirichlet, doub
 int mf_pressure_solve(mf_module *m, const mf_sim *sim, const char *field, const mf_csr *A,
                       const double *b, double *x, mf_solve_report *rep)
 {
+    return mf_pressure_solve_rows(m, sim, field, A, NULL, b, x, rep);
+}
+
+int mf_pressure_solve_rows(mf_module *m, const mf_sim *sim, const char *field, const mf_csr *A,
+                           const mf_rows *rows, const double *b, double *x,
+                           mf_solve_report *rep)
+{
     const mf_pressure_ops *ops = (const mf_pressure_ops *)m->info;
     mf_solve_report local;
     if (!rep)
         rep = &local;
     memset(rep, 0, sizeof *rep);
     const double t0 = mf_wall_seconds();
-    int rc = ops->solve(m->data, A, b, x, rep);
+    int rc = rows && ops->solve_rows ? ops->solve_rows(m->data, A, rows, b, x, rep)
+                                     : ops->solve(m->data, A, b, x, rep);
     rc = fault_point(sim, MF_FAULT_PRESSURE, m->info->name, x, A ? A->nrows : 0, rc);
     m->calls++;
     m->seconds += mf_wall_seconds() - t0;

@@ -184,6 +184,7 @@ static int write_now(mf_run *run)
     if (!run->writer_ops)
         return 0;
     MF_CALL(run->writer_ops->write(run->writer->data, run->sim, run->params));
+    run->sim->snapshot_epoch++;
     for (size_t k = 0; k < run->nfunctions; k++) {
         const mf_function_object_ops *fo = (const mf_function_object_ops *)run->functions[k].info;
         if (fo->write)

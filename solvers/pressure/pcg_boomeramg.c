@@ -4,20 +4,39 @@
  * The defaults are those that work well for MPS pressure matrices (about
  * 30 non-zeros per row in 3-D): HMIS coarsening, extended+i interpolation
  * truncated to 4 weights per row, l1-scaled symmetric hybrid Gauss-Seidel,
- * one level of aggressive coarsening (measured faster: a cheaper hierarchy
- * outweighs a few more iterations). PCG needs a symmetric positive definite
+ * one level of aggressive coarsening (measured faster when the hierarchy is
+ * built for each solve: a cheaper set-up outweighs a few more iterations;
+ * the MPS solver asks for none in 2-D, where the hierarchy is kept across
+ * steps, mps_module.c). PCG needs a symmetric positive definite
  * preconditioner, hence a symmetric smoother and a fixed cycle (one V-cycle,
  * tolerance 0, so BoomerAMG never stops early or flags non-convergence).
  *
- * reuseSetup > 0 keeps the hierarchy for that many further solves as long
- * as the matrix size and sparsity pattern do not change (the values may:
- * the fine level always uses the new matrix; coarse levels are from the old
- * one). A reused hierarchy that fails to converge is rebuilt and the solve
- * repeated once from the same initial guess.
+ * Keeping a hierarchy. BoomerAMG's solve takes the fine-level matrix it is
+ * given (hypre_BoomerAMGSolve sets A_array[0] = A), so a hierarchy set up
+ * for one matrix preconditions another of the same size: coarse levels and
+ * interpolation are the old matrix's, PCG works on the new one, and the
+ * answer is as accurate as ever (only the iteration count can suffer).
+ *  - reuseHierarchy (default yes): when the caller names the rows (mf_rows,
+ *    the MPS pressure equation: one slot per particle), the system is
+ *    assembled in slot space (hypre_common.c), so its size and the meaning
+ *    of each row stay fixed while the free surface and the neighbour pairs
+ *    change, and one hierarchy serves step after step. It is rebuilt when
+ *    the slots change meaning (a new epoch: the particles were reordered,
+ *    added or removed) and when a solve took more than rebuildRatio times
+ *    the iterations of the hierarchy's first solve (at least two more).
+ *    Without the rebuild a kept hierarchy ages: on the 2-D bench dam break
+ *    the iterations grow from 5 to 8 over 25 steps and to 49 over 1000
+ *    (docs/incoming/iface.md).
+ *  - reuseSetup > 0 keeps the hierarchy for that many further solves as
+ *    long as the matrix size and sparsity pattern do not change (the
+ *    implicit viscosity: one matrix, a solve per velocity component).
+ * A kept hierarchy that fails to converge is rebuilt and the solve repeated
+ * once from the same initial guess.
  */
 #define MF_PRESSURE_HYPRE_INTERNAL
 #include "pressure_hypre.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -27,10 +46,17 @@ static const char module_name[] = "PCG_BoomerAMG";
 
 typedef struct pcg_boomeramg {
     mf_pcg_boomeramg_settings s;
-    HYPRE_Solver amg;  /* between solves only when reuse_setup > 0 */
-    uint64_t pattern;  /* fingerprint of the matrix amg was set up with */
-    long reuses_left;  /* further solves amg may serve */
+    HYPRE_Solver amg;  /* between solves only when it may serve again */
     bool reused;       /* the current solve reuses amg */
+    /* reuseSetup: the pattern amg was set up with, the solves it may serve. */
+    uint64_t pattern;
+    long reuses_left;
+    /* reuseHierarchy: amg was set up in slot space (nslots, epoch), its
+     * first solve took first_iterations (-1: not yet), the last one last. */
+    bool slot_space;
+    int64_t nslots;
+    uint64_t epoch;
+    int first_iterations, last_iterations;
 } pcg_boomeramg;
 
 #define P(field) offsetof(mf_pcg_boomeramg_settings, field)
@@ -54,6 +80,12 @@ static const mf_param params[] = {
      "18 l1 Jacobi"},
     {"reuseSetup", MF_PARAM_INT, "0", 0, 1000, NULL, P(reuse_setup),
      "further solves that may reuse the AMG hierarchy while the pattern is unchanged (0 = never)"},
+    {"reuseHierarchy", MF_PARAM_BOOL, "yes", MF_NO_RANGE, NULL, P(reuse_hierarchy),
+     "keep the AMG hierarchy across solves whose rows the caller names (the MPS pressure "
+     "equation), rebuilding it when the rows change meaning or the iterations grow"},
+    {"rebuildRatio", MF_PARAM_SCALAR, "2", 1, 100, NULL, P(rebuild_ratio),
+     "rebuild a kept hierarchy after a solve that took more than this many times the "
+     "iterations of its first solve"},
 };
 #undef P
 
@@ -71,6 +103,9 @@ static int check_settings(const mf_pcg_boomeramg_settings *s)
     if (s->aggressive_levels < 0 || s->aggressive_levels > 25)
         return MF_ERROR(MF_ERR_INPUT, "%s: aggressiveLevels %ld is not in [0, 25]", module_name,
                         s->aggressive_levels);
+    if (!(s->rebuild_ratio >= 1 && s->rebuild_ratio <= 100))
+        return MF_ERROR(MF_ERR_INPUT, "%s: rebuildRatio %g is not in [1, 100]", module_name,
+                        s->rebuild_ratio);
     ok = false;
     for (size_t i = 0; i < sizeof coarsen_types / sizeof *coarsen_types; i++)
         ok = ok || s->coarsen_type == coarsen_types[i];
@@ -119,6 +154,7 @@ static void discard_hierarchy(pcg_boomeramg *d)
         HYPRE_BoomerAMGDestroy(d->amg);
     d->amg = NULL;
     d->reuses_left = 0;
+    d->slot_space = false;
 }
 
 static int create_amg(const mf_pcg_boomeramg_settings *s, HYPRE_Solver *out)
@@ -166,10 +202,40 @@ static HYPRE_Int keep_hierarchy(HYPRE_Solver amg, HYPRE_ParCSRMatrix A, HYPRE_Pa
     return 0;
 }
 
-static int precond_prepare(void *ctx, const mf_csr *A, mf_hypre_precond *pc)
+/* reuseHierarchy: whether the kept hierarchy may serve this solve in slot
+ * space (same slots, same epoch, its iterations not grown too far). */
+static bool may_keep(const pcg_boomeramg *d, const mf_rows *rows)
+{
+    if (!d->amg || !d->slot_space || rows->nslots != d->nslots || rows->epoch != d->epoch)
+        return false;
+    const int first = d->first_iterations;
+    if (first < 0)
+        return true;
+    const double bound = fmax(d->s.rebuild_ratio * first, first + 2.0);
+    return d->last_iterations <= bound;
+}
+
+static int precond_prepare(void *ctx, const mf_csr *A, const mf_rows *rows, mf_hypre_precond *pc)
 {
     pcg_boomeramg *d = ctx;
     d->reused = false;
+    if (rows && d->s.reuse_hierarchy) {
+        if (may_keep(d, rows)) {
+            d->reused = true;
+            *pc = (mf_hypre_precond){HYPRE_BoomerAMGSolve, keep_hierarchy, d->amg};
+            return 0;
+        }
+        discard_hierarchy(d);
+        MF_CALL(create_amg(&d->s, &d->amg));
+        d->slot_space = true;
+        d->nslots = rows->nslots;
+        d->epoch = rows->epoch;
+        d->first_iterations = -1;
+        *pc = (mf_hypre_precond){HYPRE_BoomerAMGSolve, HYPRE_BoomerAMGSetup, d->amg};
+        return 0;
+    }
+    if (d->slot_space) /* set up in slot space: of no use to a system in rows */
+        discard_hierarchy(d);
     if (d->s.reuse_setup > 0) {
         uint64_t pattern = 0;
         MF_CALL(mf_hypre_pattern_hash(A, &pattern));
@@ -188,22 +254,32 @@ static int precond_prepare(void *ctx, const mf_csr *A, mf_hypre_precond *pc)
     return 0;
 }
 
-static void precond_release(void *ctx, bool converged)
+static void precond_release(void *ctx, const mf_solve_report *rep, bool converged)
 {
     pcg_boomeramg *d = ctx;
-    /* Keep the hierarchy only if it may serve again and just did its job. */
-    if (d->s.reuse_setup == 0 || !converged)
+    if (!converged) { /* the retry (pcg_boomeramg_solve) starts from a fresh one */
+        discard_hierarchy(d);
+        return;
+    }
+    if (d->slot_space) {
+        if (d->first_iterations < 0)
+            d->first_iterations = rep->iterations;
+        d->last_iterations = rep->iterations;
+        return;
+    }
+    /* Keep the hierarchy only if it may serve again. */
+    if (d->s.reuse_setup == 0)
         discard_hierarchy(d);
 }
 
-static int pcg_boomeramg_solve(void *data, const mf_csr *A, const double *b, double *x,
-                               mf_solve_report *rep)
+static int solve_impl(pcg_boomeramg *d, const mf_csr *A, const mf_rows *rows, const double *b,
+                      double *x, mf_solve_report *rep)
 {
-    pcg_boomeramg *d = data;
     const mf_hypre_pcg pcg = {
         .name = module_name,
         .tolerance = d->s.tolerance,
         .max_iter = d->s.max_iter,
+        .rows = d->s.reuse_hierarchy ? rows : NULL,
         .precond_prepare = precond_prepare,
         .precond_release = precond_release,
         .ctx = d,
@@ -212,7 +288,7 @@ static int pcg_boomeramg_solve(void *data, const mf_csr *A, const double *b, dou
     if (rep == NULL)
         rep = &local;
     d->reused = false;
-    if (d->s.reuse_setup == 0 || d->amg == NULL || A == NULL || x == NULL) {
+    if (d->amg == NULL || A == NULL || x == NULL) {
         MF_CALL(mf_hypre_pcg_solve(&pcg, A, b, x, rep));
         return 0;
     }
@@ -240,6 +316,18 @@ static int pcg_boomeramg_solve(void *data, const mf_csr *A, const double *b, dou
     return 0;
 }
 
+static int pcg_boomeramg_solve(void *data, const mf_csr *A, const double *b, double *x,
+                               mf_solve_report *rep)
+{
+    return solve_impl(data, A, NULL, b, x, rep);
+}
+
+static int pcg_boomeramg_solve_rows(void *data, const mf_csr *A, const mf_rows *rows,
+                                    const double *b, double *x, mf_solve_report *rep)
+{
+    return solve_impl(data, A, rows, b, x, rep);
+}
+
 static void pcg_boomeramg_destroy(void *data)
 {
     pcg_boomeramg *d = data;
@@ -256,4 +344,5 @@ const mf_pressure_ops mf_pressure_PCG_BoomerAMG = {
     .create = pcg_boomeramg_create,
     .solve = pcg_boomeramg_solve,
     .destroy = pcg_boomeramg_destroy,
+    .solve_rows = pcg_boomeramg_solve_rows,
 };

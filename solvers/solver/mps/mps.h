@@ -82,6 +82,8 @@ typedef struct mps_data {
     double *rhs, *x;
     mf_csr A;
     size_t cap_rows, cap_nnz;
+    int64_t *slot;     /* PPE row -> its name for the pressure module (mf_rows) */
+    size_t cap_slot;
     /* Last solve, for the log and for benchmarks. */
     mf_solve_report last;
     long ppe_rows;
@@ -177,6 +179,18 @@ extern const char *const mps_viscosity_choices[]; /* explicit, implicit */
 
 
 /* mps_module.c */
+/* A linear solve of the solver (kind pressure): the module named by
+ * solverDict's `key { solver NAME; ... }` (PCG_BoomerAMG when absent),
+ * created with the case's settings and, where the case does not give them
+ * and the module has them, the solver's defaults. tolerance (may be NULL):
+ * the tolerance used, NAN if the module has none. */
+typedef struct mps_default {
+    const char *key;
+    double value;
+} mps_default;
+int mps_create_solve(const mf_sim *sim, const mf_dict *solver_dict, const char *key,
+                     const mps_default *defaults, size_t ndefaults, mf_module *out,
+                     double *tolerance);
 int mps_create_data(const mps_settings *s, mf_sim *sim, const mf_dict *solver_dict,
                     mps_data **out);
 void mps_destroy_data(mps_data *d);

@@ -39,81 +39,24 @@ typedef struct mps_viscosity {
     double seconds;
 } mps_viscosity;
 
-/* The viscous solve's own defaults, for the keys the chosen module has and
- * the case does not set: a tighter tolerance than the pressure's (the solve
- * is cheap, a few iterations), and one AMG set-up for the dim components,
- * which share the matrix. */
-static double viscous_default(const char *key, const mf_sim *sim)
-{
-    return strcmp(key, "tolerance") == 0 ? 1e-10 : (double)(sim->dim - 1);
-}
-static const char *const viscous_keys[] = {"tolerance", "reuseSetup"};
-
-static bool module_has_param(const mf_module_info *info, const char *key)
-{
-    for (size_t i = 0; i < info->nparams; i++)
-        if (strcmp(info->params[i].name, key) == 0)
-            return true;
-    return false;
-}
-
-/* The case's `viscosity { ... }` (may be NULL) with the viscous defaults
- * added where the module declares the key and the case does not give it. */
-static int viscous_dict(const mf_dict *vd, const mf_module_info *info, const mf_sim *sim,
-                        mf_dict **out)
-{
-    mf_dict *m = mf_dict_new("viscosity", NULL);
-    if (!m)
-        return MF_ERROR(MF_ERR_MEMORY, "out of memory");
-    *out = m;
-    for (size_t k = 0; vd && k < vd->n; k++) {
-        const mf_entry *e = vd->entries[k];
-        mf_value **items = calloc(e->n ? e->n : 1, sizeof *items);
-        if (!items)
-            return MF_ERROR(MF_ERR_MEMORY, "out of memory");
-        for (size_t i = 0; i < e->n; i++)
-            items[i] = mf_value_copy(e->items[i], m);
-        if (!mf_dict_set(m, e->key, e->loc, e->n, items))
-            return MF_ERROR(MF_ERR_MEMORY, "out of memory");
-    }
-    for (size_t k = 0; k < sizeof viscous_keys / sizeof *viscous_keys; k++)
-        if (module_has_param(info, viscous_keys[k]) && !mf_dict_find(m, viscous_keys[k]))
-            MF_CALL(mf_dict_set_number(m, viscous_keys[k], viscous_default(viscous_keys[k], sim)));
-    return 0;
-}
-
 int mps_viscosity_create(mps_data *d, mf_sim *sim, const mf_dict *solver_dict)
 {
     mps_viscosity *v = calloc(1, sizeof *v);
     if (!v)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory");
     d->visc = v;
-    const mf_dict *vd = solver_dict ? mf_dict_subdict(solver_dict, "viscosity") : NULL;
-    const char *name = "PCG_BoomerAMG";
-    if (vd)
-        MF_CALL(mf_dict_get_word_or(vd, "solver", name, &name));
-    const mf_module_info *info = NULL;
-    MF_CALL(mf_registry_find(sim->reg, MF_KIND_PRESSURE, name, &info));
-    mf_dict *merged = NULL;
-    static const char *const extra[] = {"solver", NULL};
-    int rc = viscous_dict(vd, info, sim, &merged);
-    if (rc == 0)
-        rc = mf_module_prepare(sim->reg, MF_KIND_PRESSURE, name, merged, extra, NULL,
-                               &v->solver);
-    for (size_t k = 0; rc == 0 && vd && k < vd->n; k++) /* read through the copy */
-        vd->entries[k]->used = true;
+    /* Defaults where the case is silent: a tighter tolerance than the
+     * pressure's (the solve is cheap, a few iterations), and one AMG set-up
+     * for the dim components, which share the matrix. */
+    const mps_default defaults[] = {{"tolerance", 1e-10}, {"reuseSetup", sim->dim - 1}};
     double tolerance = NAN;
-    if (rc == 0)
-        mf_dict_get_number_or(merged, "tolerance", NAN, &tolerance);
-    mf_dict_free(merged);
-    MF_CALL(rc);
+    MF_CALL(mps_create_solve(sim, solver_dict, "viscosity", defaults, 2, &v->solver, &tolerance));
     v->ops = (const mf_pressure_ops *)v->solver.info;
-    MF_CALL(v->ops->create(v->solver.settings, &v->solver.data));
     /* The viscous limit of the time step does not apply any more. */
     sim->viscosity_implicit = true;
     mf_log_printf(sim->log, MF_LOG_NORMAL,
-                  "Viscosity: implicit (%s, tolerance %g); no viscous time-step limit\n", name,
-                  tolerance);
+                  "Viscosity: implicit (%s, tolerance %g); no viscous time-step limit\n",
+                  v->solver.info->name, tolerance);
     return 0;
 }
 
