@@ -181,13 +181,14 @@ static void test_tables(void)
     }
     mf_pcg_boomeramg_settings s;
     defaults(&mf_pressure_PCG_BoomerAMG, &s);
-    CHECK(s.coarsen_type == 10 && s.interp_type == 6 && s.p_max_elmts == 4 && s.relax_type == 8);
+    CHECK(s.coarsen_type == 10 && s.interp_type == 17 && s.p_max_elmts == 4 && s.relax_type == 3);
     CHECK(s.strong_threshold == 0.25 && s.aggressive_levels == 1 && s.reuse_setup == 0);
     CHECK(s.tolerance == 1e-8 && s.max_iter == 500);
 
-    /* A non-symmetric smoother would break PCG: refused at create. */
+    /* A smoother that makes a non-symmetric cycle (backward GS on both
+     * ways) would break PCG: refused at create. */
     void *data = NULL;
-    s.relax_type = 3;
+    s.relax_type = 4;
     CHECK(mf_pressure_PCG_BoomerAMG.create(&s, &data) == MF_ERR_INPUT && data == NULL);
     mf_error_clear();
     mf_pcg_diagonal_settings ds = {.tolerance = 0.0, .max_iter = 10};
