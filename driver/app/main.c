@@ -198,8 +198,27 @@ int mf_cmd_run(mf_app *app)
     return 0;
 }
 
+/* OpenMP's wait policy, before anything else. libgomp's default spins a
+ * waiting thread for up to 300,000 iterations at every barrier; when
+ * another process holds the second core, the team's other thread is not
+ * running, every barrier waits out a time slice, and two threads made a step
+ * 25 to 40 times slower than one (the neighbour search: 1 ms to 400 ms).
+ * Passive waiting (sleep at once) keeps two threads at or below one thread's
+ * time on a loaded machine (docs/incoming/iface.md has the measurements).
+ * libgomp reads the policy from the environment when it loads, before main:
+ * so set it and start again, unless the user chose a policy. */
+static void openmp_wait_policy(char **argv)
+{
+    if (getenv("OMP_WAIT_POLICY") || getenv("GOMP_SPINCOUNT"))
+        return;
+    if (setenv("OMP_WAIT_POLICY", "PASSIVE", 1) != 0)
+        return;
+    execv("/proc/self/exe", argv); /* returns only on failure: go on as we are */
+}
+
 int main(int argc, char **argv)
 {
+    openmp_wait_policy(argv);
     mf_app app;
     memset(&app, 0, sizeof app);
     app.opt.case_dir = ".";
