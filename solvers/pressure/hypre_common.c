@@ -292,7 +292,8 @@ static int assemble(const char *who, const mf_csr *A, const mf_rows *rows, const
     HYPRE_Int *diag_sizes = malloc(((size_t)n + 1) * sizeof *diag_sizes);
     HYPRE_Int *offd_sizes = malloc(((size_t)n + 1) * sizeof *offd_sizes);
     HYPRE_BigInt *cols = malloc((nnz + 1) * sizeof *cols);
-    double *vals = rows ? malloc((nnz + 1) * sizeof *vals) : NULL;
+    /* The free slots' values (the rows' own go in from A->val). */
+    double *vals = rows ? malloc(((size_t)(n - nrows) + 1) * sizeof *vals) : NULL;
     double *bx = rows ? malloc(((size_t)n + 1) * sizeof *bx) : NULL;
     uint8_t *used = rows ? calloc((size_t)n + 1, 1) : NULL;
     sys->rows = malloc(((size_t)n + 1) * sizeof *sys->rows);
@@ -335,7 +336,6 @@ static int assemble(const char *who, const mf_csr *A, const mf_rows *rows, const
             diag_sizes[s] = ncols[i];
             for (size_t k = A->rowptr[i]; k < A->rowptr[i + 1]; k++) {
                 cols[k - k0] = (HYPRE_BigInt)rows->slot[A->col[k] - A->row_offset];
-                vals[k - k0] = A->val[k];
                 if (A->col[k] == A->row_offset + i)
                     dsum += fabs(A->val[k]);
             }
@@ -350,7 +350,7 @@ static int assemble(const char *who, const mf_csr *A, const mf_rows *rows, const
                 ncols[next] = 1;
                 diag_sizes[s] = 1;
                 cols[k] = s;
-                vals[k++] = d;
+                vals[k++ - nnz_rows] = d;
                 bx[next++] = 0.0;
             }
         for (HYPRE_Int s = 0; s < n; s++)
@@ -363,9 +363,13 @@ static int assemble(const char *who, const mf_csr *A, const mf_rows *rows, const
     MF_HYPRE_CALL(who, rc, out, HYPRE_IJMatrixSetPrintLevel, (sys->A, 0));
     MF_HYPRE_CALL(who, rc, out, HYPRE_IJMatrixSetDiagOffdSizes, (sys->A, diag_sizes, offd_sizes));
     MF_HYPRE_CALL(who, rc, out, HYPRE_IJMatrixInitialize, (sys->A));
+    /* The rows (their values as the caller has them), then the free slots. */
     MF_HYPRE_CALL(who, rc, out, HYPRE_IJMatrixSetValues,
-                  (sys->A, n, ncols, sys->rows, cols,
-                   rows ? vals : (n > 0 ? A->val + k0 : NULL)));
+                  (sys->A, nrows, ncols, sys->rows, cols, nrows > 0 ? A->val + k0 : NULL));
+    if (n > nrows)
+        MF_HYPRE_CALL(who, rc, out, HYPRE_IJMatrixSetValues,
+                      (sys->A, n - nrows, ncols + nrows, sys->rows + nrows, cols + nnz_rows,
+                       vals));
     MF_HYPRE_CALL(who, rc, out, HYPRE_IJMatrixAssemble, (sys->A));
     MF_HYPRE_CALL(who, rc, out, HYPRE_IJMatrixGetObject, (sys->A, &obj));
     sys->parA = (HYPRE_ParCSRMatrix)obj;
