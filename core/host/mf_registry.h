@@ -31,7 +31,7 @@
 /* Versions of the tables' layout (mf_modules.h lists what each added):
  *   1  the first tables;
  *   2  force: flags, stable_dt, write_fields, claim_surface_pressure,
- *      surface_pressure; pressure: solve_rows. */
+ *      surface_pressure; pressure: solve_rows; writer: purge. */
 #define MF_ABI_VERSION 2
 #define MF_ABI_OLDEST 1
 

@@ -49,7 +49,8 @@ size_t mf_ops_size(mf_module_kind kind, int abi)
     case MF_KIND_FORCE: return abi >= 2 ? sizeof(mf_force_ops) : offsetof(mf_force_ops, flags);
     case MF_KIND_FUNCTION_OBJECT: return sizeof(mf_function_object_ops);
     case MF_KIND_SURFACE: return sizeof(mf_surface_ops);
-    case MF_KIND_WRITER: return sizeof(mf_writer_ops);
+    /* ABI 2 added purge. */
+    case MF_KIND_WRITER: return abi >= 2 ? sizeof(mf_writer_ops) : offsetof(mf_writer_ops, purge);
     default: return 0;
     }
 }
