@@ -12,20 +12,6 @@
 #include "mf_error.h"
 #include "mf_timestep.h"
 
-double mf_wall_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
-double mf_cpu_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
 size_t mf_peak_memory(void)
 {
     struct rusage ru;
@@ -166,13 +152,14 @@ static int choose_dt(mf_run *run, double next_write, double *dt, const char **li
             natural = 1.2 * last;
             *limiter = "growth";
         }
-        if (run->solver_ops->stable_dt) {
-            double sdt = INFINITY;
-            MF_CALL(run->solver_ops->stable_dt(run->solver->data, sim, &sdt));
-            if (sdt < natural) {
-                natural = sdt;
-                *limiter = "solver";
-            }
+        /* The solver's and every force's own limit (surfaceTension's
+         * capillary step, a plugin's), whatever the solver. */
+        double sdt = INFINITY;
+        const char *who = NULL;
+        MF_CALL(mf_stable_dt(run->solver, sim, &sdt, &who));
+        if (sdt < natural) {
+            natural = sdt;
+            *limiter = who;
         }
         run->sim->dt_natural = natural;
         *dt = natural;
@@ -198,6 +185,7 @@ static int write_now(mf_run *run)
     if (!run->writer_ops)
         return 0;
     MF_CALL(run->writer_ops->write(run->writer->data, run->sim, run->params));
+    run->sim->snapshot_epoch++;
     for (size_t k = 0; k < run->nfunctions; k++) {
         const mf_function_object_ops *fo = (const mf_function_object_ops *)run->functions[k].info;
         if (fo->write)
@@ -237,16 +225,18 @@ static int step_once(mf_run *run, saved_state *saved, double next_write)
     size_t added = 0, removed = 0;
     for (long attempt = 0;; attempt++) {
         sim->dt = dt;
-        mf_courant(sim->p, dt, sim->l0, &sim->courant_mean, &sim->courant_max);
-        mf_log_printf(sim->log, MF_LOG_STEP, "Courant Number mean: %g max: %g\n",
-                      sim->courant_mean, sim->courant_max);
+        double courant_mean = 0, courant_max = 0;
+        mf_courant(sim->p, dt, sim->l0, &courant_mean, &courant_max);
+        mf_log_printf(sim->log, MF_LOG_STEP, "Courant Number mean: %g max: %g\n", courant_mean,
+                      courant_max);
         mf_log_printf(sim->log, MF_LOG_STEP, "deltaT = %g\n", dt);
         mf_log_printf(sim->log, MF_LOG_STEP, "Time = %.10g\n\n", sim->time + dt);
         double kinetic_in = 0;
         int rc = apply_emitters(run, dt, &kinetic_in, &added, &removed);
         run->watch.work = work0 + kinetic_in;
+        sim->forces_record.valid = false; /* set again by this attempt's forces */
         if (rc == 0)
-            rc = run->solver_ops->step(run->solver->data, sim, dt);
+            rc = mf_solver_step(run->solver, sim, dt);
         if (rc == 0) {
             sim->time = saved->time + dt; /* the watch reports the time reached */
             rc = mf_watch_check(&run->watch, sim, dt);
@@ -315,6 +305,16 @@ int mf_run_loop(mf_run *run, bool write_initial)
         run->watch.s.density_collapse = 0;
         mf_log_printf(sim->log, MF_LOG_NORMAL,
                       "Watch: no density-collapse check, nozzles add thin jets of fluid\n");
+    }
+    if (!run->ctl.adjust) { /* a fixed step is the user's choice: say when it is too long */
+        double sdt = INFINITY;
+        const char *who = NULL;
+        MF_CALL_GOTO(rc, mf_stable_dt(run->solver, sim, &sdt, &who), done);
+        if (run->ctl.delta_t > sdt)
+            mf_log_printf(sim->log, MF_LOG_QUIET,
+                          "Warning: deltaT %g s is above the stable step of %s, %g s "
+                          "(adjustTimeStep no keeps it): the run may go unstable\n",
+                          run->ctl.delta_t, who, sdt);
     }
     if (write_initial)
         MF_CALL_GOTO(rc, write_now(run), done);

@@ -30,20 +30,6 @@ int mf_watch_init(mf_watch *w, const mf_dict *dict, mf_dict *resolved)
     return 0;
 }
 
-void mf_watch_free(mf_watch *w)
-{
-    free(w->acc);
-    w->acc = NULL;
-}
-
-/* Mass of particle i: rho l0^d of its fluid (FluidId when there are several). */
-static double particle_mass(const mf_sim *sim, int fluid_field, size_t i)
-{
-    int f = fluid_field >= 0 ? mf_particles_fi(sim->p, fluid_field)[i] : 0;
-    double vol = sim->dim == 3 ? sim->l0 * sim->l0 * sim->l0 : sim->l0 * sim->l0;
-    return sim->fluid[f].rho * vol;
-}
-
 static int check_non_finite(const mf_sim *sim)
 {
     const mf_particles *p = sim->p;
@@ -147,33 +133,31 @@ static int check_density(mf_watch *w, const mf_sim *sim)
                     (long long)sim->p->id[thinnest], x[0], x[1], x[2]);
 }
 
-/* Kinetic energy, and the power of the force modules (sum m a.v). */
-static int energy(mf_watch *w, const mf_sim *sim, double *ke, double *power, double *mass_acc)
+/* Kinetic energy; the power of the step's force accelerations a^n (what
+ * mf_force_accumulate recorded, carried with the particles in the
+ * ForceAcceleration field) at the end of the step, sum m a^n.u^{n+1}, and at
+ * its start (the record's power, sum m a^n.u^n); and sum m |a^n|. A step
+ * whose forces did not run (no forces) has none. */
+static void energy(const mf_sim *sim, double *ke, double *power_start, double *power_end,
+                   double *mass_acc)
 {
     const mf_particles *p = sim->p;
-    if (w->cap < p->n) {
-        free(w->acc);
-        w->cap = p->n + p->n / 4 + 16;
-        w->acc = malloc(3 * w->cap * sizeof *w->acc);
-        if (!w->acc)
-            return MF_ERROR(MF_ERR_MEMORY, "out of memory in the run's watch");
-    }
-    memset(w->acc, 0, 3 * p->n * sizeof *w->acc);
-    for (size_t k = 0; k < sim->nforces; k++) {
-        const mf_force_ops *ops = (const mf_force_ops *)sim->forces[k].info;
-        MF_CALL(ops->accumulate(sim->forces[k].data, sim, w->acc));
-    }
-    int ff = mf_particles_field_index(p, "FluidId");
-    *ke = *power = *mass_acc = 0;
+    const int ff = mf_particles_field_index(p, "FluidId");
+    const int fa = sim->forces_record.valid ? mf_particles_field_index(p, MF_FORCE_FIELD) : -1;
+    const double *acc = fa >= 0 ? mf_particles_fd(p, fa) : NULL;
+    *ke = *power_end = *mass_acc = 0;
+    *power_start = acc ? sim->forces_record.power : 0;
     for (size_t i = 0; i < p->n_owned; i++) {
         if (p->kind[i] != MF_FLUID)
             continue;
-        const double m = particle_mass(sim, ff, i), *v = &p->vel[3 * i], *a = &w->acc[3 * i];
+        const double m = mf_sim_particle_mass(sim, ff, i), *v = &p->vel[3 * i];
         *ke += 0.5 * m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-        *power += m * (a[0] * v[0] + a[1] * v[1] + a[2] * v[2]);
+        if (!acc)
+            continue;
+        const double *a = &acc[3 * i];
+        *power_end += m * (a[0] * v[0] + a[1] * v[1] + a[2] * v[2]);
         *mass_acc += m * sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
     }
-    return 0;
 }
 
 static double fluid_extent(const mf_sim *sim)
@@ -237,19 +221,18 @@ static size_t fastest_fluid(const mf_sim *sim, double *speed)
 
 static int check_energy(mf_watch *w, const mf_sim *sim, double dt)
 {
-    double ke = 0, power = 0, mass_acc = 0;
-    MF_CALL(energy(w, sim, &ke, &power, &mass_acc));
+    double ke = 0, power_start = 0, power_end = 0, mass_acc = 0;
+    energy(sim, &ke, &power_start, &power_end, &mass_acc);
     if (!w->started) { /* the state the run starts from (after its first step) */
         w->started = true;
         w->ke0 = ke;
         w->pot_scale = mass_acc * fluid_extent(sim) + surface_energy(sim);
         w->next_work = 0;
-        w->next_power = power;
         return 0;
     }
-    /* Trapezoidal rule between the last accepted step and this one. */
-    w->next_work = w->work + 0.5 * (w->power + power) * dt;
-    w->next_power = power;
+    /* The work of the step's forces, a^n held over the step while u goes
+     * from u^n to u^{n+1}: the trapezoidal rule in u. */
+    w->next_work = w->work + 0.5 * (power_start + power_end) * dt;
     double excess = ke - w->ke0 - w->next_work;
     double scale = w->ke0 + fabs(w->next_work) + w->pot_scale;
     if (!(scale > 0 && excess > w->s.energy_tolerance * scale))
@@ -281,5 +264,4 @@ int mf_watch_check(mf_watch *w, const mf_sim *sim, double dt)
 void mf_watch_accept(mf_watch *w)
 {
     w->work = w->next_work;
-    w->power = w->next_power;
 }

@@ -225,6 +225,13 @@ int mf_cmd_run(mf_app *app)
     const mf_solver_ops *ops = (const mf_solver_ops *)app->solver.info;
     if (ops->report)
         ops->report(app->solver.data, &app->sim, &app->log);
+    /* What the calling wrappers counted (mf_modules.h). */
+    mf_log_printf(&app->log, MF_LOG_QUIET, "Solver %s: %ld steps, %.3f s\n",
+                  app->solver.info->name, app->solver.calls, app->solver.seconds);
+    for (size_t k = 0; k < app->sim.nforces; k++)
+        mf_log_printf(&app->log, MF_LOG_QUIET, "Force %s: %ld calls, %.3f s\n",
+                      app->sim.forces[k].info->name, app->sim.forces[k].calls,
+                      app->sim.forces[k].seconds);
     mf_log_printf(&app->log, MF_LOG_QUIET,
                   "\nSteps %ld (retried %ld), snapshots %d, wall time %.2f s, peak memory %.1f "
                   "MB\n",
@@ -238,8 +245,27 @@ int mf_cmd_run(mf_app *app)
     return 0;
 }
 
+/* OpenMP's wait policy, before anything else. libgomp's default spins a
+ * waiting thread for up to 300,000 iterations at every barrier; when
+ * another process holds the second core, the team's other thread is not
+ * running, every barrier waits out a time slice, and two threads made a step
+ * 25 to 40 times slower than one (the neighbour search: 1 ms to 400 ms).
+ * Passive waiting (sleep at once) keeps two threads at or below one thread's
+ * time on a loaded machine (docs/incoming/iface.md has the measurements).
+ * libgomp reads the policy from the environment when it loads, before main:
+ * so set it and start again, unless the user chose a policy. */
+static void openmp_wait_policy(char **argv)
+{
+    if (getenv("OMP_WAIT_POLICY") || getenv("GOMP_SPINCOUNT"))
+        return;
+    if (setenv("OMP_WAIT_POLICY", "PASSIVE", 1) != 0)
+        return;
+    execv("/proc/self/exe", argv); /* returns only on failure: go on as we are */
+}
+
 int main(int argc, char **argv)
 {
+    openmp_wait_policy(argv);
     /* Whole lines reach a redirected log at once (tail -f, a kill). */
     setvbuf(stdout, NULL, _IOLBF, 0);
     mf_app app;
