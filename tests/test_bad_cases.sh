@@ -28,7 +28,7 @@ fresh() { rm -rf "$dir/case"; cp -r "$tutorial/." "$dir/case/"; rm -rf "$dir/cas
 fresh
 expect "no such case" "cannot open.*is '$dir/nothing' a case directory" -case "$dir/nothing" -dryRun
 expect "unknown option" "unknown option '-dryrun'.*did you mean '-dryRun'" -case "$dir/case" -dryrun
-expect "bad -l0" "-l0 takes a positive number, not 'abc'" -case "$dir/case" -l0 abc -dryRun
+expect "bad -l0" "-l0 takes a positive finite number, not 'abc'" -case "$dir/case" -l0 abc -dryRun
 expect "unknown command" "unknown command 'modulse'.*did you mean 'modules'" modulse
 
 fresh; sed -i 's/^endTime /endTme  /' "$dir/case/system/controlDict"

@@ -37,6 +37,30 @@ struct mf_trimesh_reader;
 int mf_scene_build_with_reader(const mf_dict *geometry, double l0_override, mf_sim *sim,
                                mf_dict *resolved, const struct mf_trimesh_reader *reader);
 
+/* A memory budget checked before the scene allocates a particle: the
+ * particles the geometry will make (mf_scene_estimate_particles) times the
+ * bytes a particle costs must fit in max_bytes. */
+typedef struct mf_scene_budget {
+    double max_bytes;          /* 0: no limit */
+    double bytes_per_particle; /* mf_memory_per_particle */
+    double radius_l0;          /* the neighbour radius it was computed at, for messages */
+    const char *limit_source;  /* what set max_bytes, for messages */
+    double particles;          /* out: the estimate */
+} mf_scene_budget;
+/* mf_scene_build_with_reader, refusing (MF_ERR_INPUT, naming the count,
+ * the bytes and the key maxMemory) a scene over budget (may be NULL). */
+int mf_scene_build_budgeted(const mf_dict *geometry, double l0_override, mf_sim *sim,
+                            mf_dict *resolved, const struct mf_trimesh_reader *reader,
+                            mf_scene_budget *budget);
+/* The particles the geometry makes at sim->l0 in sim->dim (sim->end_time
+ * bounds what nozzles add), without making any: exact for boxes, from the
+ * volume for spheres, from the bounding box or area for meshes (meshes may
+ * be NULL when there are none). Entries that do not read are skipped: the
+ * builder reports them. */
+struct mf_scene_meshes;
+double mf_scene_estimate_particles(const mf_dict *geometry, const mf_sim *sim,
+                                   const struct mf_scene_meshes *meshes);
+
 /* Refuse particles closer than l0/2 (overlapping blocks, a block inside a
  * wall), naming the first pair. */
 int mf_scene_check_overlap(const mf_sim *sim);

@@ -450,7 +450,8 @@ static int visit_obstacle(mf_sim *sim, const char *name, const mf_dict *d, void 
 }
 
 static int build_scene(const mf_dict *geometry, double l0_override, mf_sim *sim,
-                       mf_dict *resolved, const mf_trimesh_reader *reader, build_ctx *ctx);
+                       mf_dict *resolved, const mf_trimesh_reader *reader, build_ctx *ctx,
+                       mf_scene_budget *budget);
 
 int mf_scene_build(const mf_dict *geometry, double l0_override, mf_sim *sim, mf_dict *resolved)
 {
@@ -460,17 +461,60 @@ int mf_scene_build(const mf_dict *geometry, double l0_override, mf_sim *sim, mf_
 int mf_scene_build_with_reader(const mf_dict *geometry, double l0_override, mf_sim *sim,
                                mf_dict *resolved, const mf_trimesh_reader *reader)
 {
+    return mf_scene_build_budgeted(geometry, l0_override, sim, resolved, reader, NULL);
+}
+
+int mf_scene_build_budgeted(const mf_dict *geometry, double l0_override, mf_sim *sim,
+                            mf_dict *resolved, const mf_trimesh_reader *reader,
+                            mf_scene_budget *budget)
+{
     build_ctx ctx = {-1, NULL, NULL};
-    int rc = build_scene(geometry, l0_override, sim, resolved, reader, &ctx);
+    int rc = build_scene(geometry, l0_override, sim, resolved, reader, &ctx, budget);
     mf_scene_meshes_destroy(ctx.meshes);
     return rc;
 }
 
+/* -l0 replaces particleSpacing: the same range applies, and a message
+ * names the option, not the file. */
+static int check_spacing_override(double l0)
+{
+    const mf_param *p = &geometry_params[1];
+    if (!isfinite(l0) || l0 < p->min || l0 > p->max)
+        return MF_ERROR(MF_ERR_INPUT, "-l0 %g is out of range [%g, %g] (%s)", l0, p->min, p->max,
+                        p->doc);
+    return 0;
+}
+
+/* The scene's particles times the bytes a particle costs, against the
+ * budget: refused before the first particle is allocated. */
+static int check_budget(const mf_dict *geometry, const mf_sim *sim,
+                        const mf_scene_meshes *meshes, mf_scene_budget *b)
+{
+    if (!b)
+        return 0;
+    b->particles = mf_scene_estimate_particles(geometry, sim, meshes);
+    const double bytes = b->particles * b->bytes_per_particle;
+    if (!(b->max_bytes > 0) || bytes <= b->max_bytes)
+        return 0;
+    char where[512];
+    return MF_ERROR(MF_ERR_INPUT,
+                    "%s: the scene would make about %.3g particles at l0 = %g m, %.3g GB at %.0f "
+                    "bytes a particle (particle arrays, neighbour lists within %g l0, the "
+                    "pressure matrix), more than maxMemory = %.3g GB (%s): use a larger "
+                    "particleSpacing (or -l0), or raise maxMemory in system/controlDict",
+                    mf_loc_str(geometry->loc, where, sizeof where), b->particles, sim->l0,
+                    bytes / 1e9, b->bytes_per_particle, b->radius_l0, b->max_bytes / 1e9,
+                    b->limit_source ? b->limit_source : "system/controlDict");
+}
+
 static int build_scene(const mf_dict *geometry, double l0_override, mf_sim *sim,
-                       mf_dict *resolved, const mf_trimesh_reader *reader, build_ctx *ctx)
+                       mf_dict *resolved, const mf_trimesh_reader *reader, build_ctx *ctx,
+                       mf_scene_budget *budget)
 {
     geometry_settings g;
     MF_CALL(mf_params_apply(geometry_params, 8, geometry, geometry_extra, &g, NULL));
+    if (l0_override > 0 || !isfinite(l0_override))
+        MF_CALL(check_spacing_override(l0_override));
     sim->dim = (int)g.dimension;
     sim->l0 = l0_override > 0 ? l0_override : g.spacing;
     if (resolved) {
@@ -483,6 +527,7 @@ static int build_scene(const mf_dict *geometry, double l0_override, mf_sim *sim,
                         mf_loc_str(geometry->loc, where, sizeof where));
     }
     MF_CALL(mf_scene_meshes_create(geometry, reader, sim->dim, sim->l0, sim->log, &ctx->meshes));
+    MF_CALL(check_budget(geometry, sim, ctx->meshes, budget));
     MF_CALL(mf_particles_create(sim->dim, 1024, &sim->p));
     if (sim->nfluids > 1)
         MF_CALL(mf_particles_request_field(sim->p, "FluidId", 1, MF_FIELD_INT32, true,

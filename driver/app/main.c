@@ -4,6 +4,7 @@
  *   mpsflow modules [NAME]
  */
 #include <limits.h>
+#include <math.h>
 #include <mpi.h>
 #include <HYPRE_utilities.h>
 #include <stdlib.h>
@@ -54,8 +55,8 @@ static int parse_number(const char *opt, const char *text, double *out)
 {
     char *end;
     *out = strtod(text, &end);
-    if (end == text || *end || !(*out > 0))
-        return MF_ERROR(MF_ERR_INPUT, "%s takes a positive number, not '%s'", opt, text);
+    if (end == text || *end || !(*out > 0) || !isfinite(*out))
+        return MF_ERROR(MF_ERR_INPUT, "%s takes a positive finite number, not '%s'", opt, text);
     return 0;
 }
 

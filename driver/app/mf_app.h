@@ -7,6 +7,7 @@
 #include "mf_case.h"
 #include "mf_modules.h"
 #include "mf_run.h"
+#include "mf_scene.h"
 #include "mf_sim.h"
 
 typedef struct mf_options {
@@ -30,6 +31,7 @@ typedef struct mf_app {
     size_t nfunctions;
     mf_module *functions;
     mf_run run;
+    mf_scene_budget budget; /* the memory estimate the scene was checked against */
 } mf_app;
 
 /* Register every built-in module (the one explicit call). */
@@ -40,6 +42,10 @@ int mf_app_load_libs_text(mf_registry *reg, const char *text);
 /* Read the case, build the scene and create the modules it names. */
 int mf_app_setup(mf_app *app);
 void mf_app_teardown(mf_app *app);
+/* The memory budget of the case's scene (memory_budget.c): maxMemory, or
+ * 80% of the machine's memory, and the bytes a particle costs at the
+ * solver's largest neighbour radius. */
+int mf_app_memory_budget(mf_app *app, mf_scene_budget *b);
 /* Print counts, kernel constants and memory (-dryRun). */
 void mf_app_summary(const mf_app *app);
 
