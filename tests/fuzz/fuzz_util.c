@@ -77,7 +77,7 @@ bool fuzz_write_file(const char *dir, const char *rel, const void *data, size_t 
 {
     char path[1200];
     snprintf(path, sizeof path, "%s/%s", dir, rel);
-    for (char *s = path + strlen(dir) + 1; (s = strchr(s, '/')) != NULL; s++) {
+    for (char *s = path + 1; (s = strchr(s, '/')) != NULL; s++) {
         *s = '\0';
         mkdir(path, 0700);
         *s = '/';

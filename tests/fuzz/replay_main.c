@@ -90,6 +90,6 @@ int main(int argc, char **argv)
         }
         free(names);
     }
-    printf("replayed %zu inputs\n", inputs);
+    fprintf(stderr, "replayed %zu inputs\n", inputs);
     return bad;
 }
