@@ -407,5 +407,7 @@ double mf_memory_per_particle(int dim, double radius_l0)
     const double nb = (double)lattice_neighbours(dim == 3 ? 3 : 2, radius_l0);
     const double lists = 2 * (nb * sizeof(uint32_t) + sizeof(size_t));
     const double matrix = 2 * (nb + 1) * (sizeof(double) + sizeof(int32_t));
-    return 2 * arrays + grid + lists + matrix;
+    /* A snapshot is built in memory before it is written: twice the arrays. */
+    const double snapshot = 2 * arrays;
+    return 2 * arrays + grid + lists + matrix + snapshot;
 }

@@ -165,6 +165,8 @@ int mf_cmd_run(mf_app *app)
         printf("\nDry run: stopping before the time loop.\nEnd\n");
         return 0;
     }
+    int stale = 0;
+    MF_CALL(mf_app_remove_stale_tmp(app->cs.dir, &app->log, &stale));
     bool restart = app->opt.latest_time || !strcmp(app->cs.control.start_from, "latestTime");
     if (restart) {
         const mf_writer_ops *w = (const mf_writer_ops *)app->writer.info;

@@ -46,6 +46,9 @@ void mf_app_teardown(mf_app *app);
  * 80% of the machine's memory, and the bytes a particle costs at the
  * solver's largest neighbour radius. */
 int mf_app_memory_budget(mf_app *app, mf_scene_budget *b);
+/* Remove the *.tmp files a killed run left in output/ and postProcessing/
+ * (stale_tmp.c), logging each; *removed counts them. */
+int mf_app_remove_stale_tmp(const char *case_dir, mf_log *log, int *removed);
 /* Print counts, kernel constants and memory (-dryRun). */
 void mf_app_summary(const mf_app *app);
 
