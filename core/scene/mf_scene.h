@@ -18,6 +18,7 @@
 #define MF_SCENE_H
 
 #include "mf_dict.h"
+#include "mf_params.h"
 #include "mf_sim.h"
 
 /* Read fluids (constant/fluids: one sub-dictionary per fluid with rho, nu,
@@ -64,8 +65,32 @@ double mf_scene_estimate_particles(const mf_dict *geometry, const mf_sim *sim,
 /* Refuse particles closer than l0/2 (overlapping blocks, a block inside a
  * wall), naming the first pair. */
 int mf_scene_check_overlap(const mf_sim *sim);
+/* The same, naming the entries of the geometry the two particles belong
+ * to (file:line:col) where their shapes tell. */
+int mf_scene_check_overlap_in(const mf_dict *geometry, const mf_sim *sim);
+/* What the run would refuse at step 0, refused before it (the dry run
+ * included), each naming its entry: overlapping particles, no fluid and no
+ * inlet or nozzle, fluid past a closed wall face, an inlet, outlet or nozzle
+ * that does not reach the walls' domain (scene_check.c). */
+int mf_scene_check_start(const mf_dict *geometry, const mf_sim *sim);
+/* True when fluid particle i is past a closed face of a wall box (the
+ * wall-particle line, l0/2 outside the region), within that face's extent:
+ * *box, *axis, *side (0 min, 1 max) say which. The watch's throughWall. */
+bool mf_scene_past_wall(const mf_sim *sim, size_t i, size_t *box, int *axis, int *side);
 
 /* Index of a fluid by name, or an error listing the fluids. */
 int mf_scene_fluid_index(const mf_sim *sim, const char *name, int *index);
+
+/* The parameter tables of constant/geometry and constant/fluids, printed by
+ * `mpsflow modules geometry|fluids` and in docs/reference.md: the tables
+ * the builder applies. */
+extern const mf_param_section mf_geometry_sections[];
+extern const size_t mf_geometry_nsections;
+extern const mf_param_section mf_mesh_sections[];
+extern const size_t mf_mesh_nsections;
+extern const mf_param_section mf_emitter_sections[];
+extern const size_t mf_emitter_nsections;
+extern const mf_param_section mf_fluid_sections[];
+extern const size_t mf_fluid_nsections;
 
 #endif

@@ -384,6 +384,16 @@ static const mf_param fluid_mesh_params[] = {
 };
 #define NPARAMS(t) (sizeof(t) / sizeof((t)[0]))
 
+const mf_param_section mf_mesh_sections[] = {
+    {"geometry: walls/<name>, type mesh", "a wall made from a polygon file (mf_trimesh.h)",
+     wall_mesh_params, NPARAMS(wall_mesh_params)},
+    {"geometry: obstacles/<name>", "a solid body in the fluid, from a polygon file",
+     obstacle_mesh_params, NPARAMS(obstacle_mesh_params)},
+    {"geometry: fluidBlocks/<name>, type mesh", "fluid filling a closed polygon surface",
+     fluid_mesh_params, NPARAMS(fluid_mesh_params)},
+};
+const size_t mf_mesh_nsections = NPARAMS(mf_mesh_sections);
+
 static const mf_param *params_of(const char *group, size_t *n)
 {
     if (strcmp(group, "fluidBlocks") == 0) {

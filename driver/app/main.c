@@ -23,6 +23,9 @@ static void usage(FILE *f)
             "Commands:\n"
             "  (none)            run the case\n"
             "  modules [NAME]    list the registered modules by kind, or the parameters of one\n"
+            "                    (also of a case dictionary: controlDict, watch, geometry,\n"
+            "                    fluids, validation, compareDict, stabilityDict)\n"
+            "  reference [FILE]  every key of every dictionary and module, as markdown\n"
             "  validate          score the case's output against its reference (validation/)\n"
             "  compare           run the case with several schemes and resolutions: error\n"
             "                    against run time (-solvers '(A B)' -resolutions '(l0 ...)')\n"
@@ -131,8 +134,14 @@ int mf_cmd_modules(mf_registry *reg, const char *name)
 {
     if (!name) {
         mf_registry_print(reg, stdout);
+        printf("case dictionaries (mpsflow modules NAME):\n   ");
+        for (size_t k = 0; mf_dict_table_names[k]; k++)
+            printf(" %s", mf_dict_table_names[k]);
+        printf("\n");
         return 0;
     }
+    if (mf_dict_tables_print(name, stdout))
+        return 0;
     const mf_module_info *m = mf_registry_lookup_any(reg, name);
     if (!m) {
         /* Let the registry's error list every name of every kind. */
@@ -209,7 +218,8 @@ int main(int argc, char **argv)
     if (command && !strcmp(command, "surface"))
         return mf_main_surface(argc, argv, first);
     const char *module_name = NULL;
-    if (command && !strcmp(command, "modules") && argc > 2 && argv[2][0] != '-') {
+    if (command && (!strcmp(command, "modules") || !strcmp(command, "reference")) && argc > 2 &&
+        argv[2][0] != '-') {
         module_name = argv[2];
         first = 3;
     }
@@ -222,7 +232,8 @@ int main(int argc, char **argv)
         mf_error_print(stderr);
         return 2;
     }
-    static const char *const commands[] = {"modules", "validate", "compare", "stability"};
+    static const char *const commands[] = {"modules", "validate", "compare", "stability",
+                                           "reference"};
     const size_t ncommands = sizeof commands / sizeof commands[0];
     bool known = !command;
     for (size_t k = 0; k < ncommands && !known; k++)
@@ -248,6 +259,8 @@ int main(int argc, char **argv)
         rc = mf_cmd_run(&app);
     else if (rc == 0 && !strcmp(command, "modules"))
         rc = mf_cmd_modules(app.reg, module_name);
+    else if (rc == 0 && !strcmp(command, "reference"))
+        rc = mf_cmd_reference(app.reg, module_name);
     else if (rc == 0 && !strcmp(command, "validate"))
         rc = mf_cmd_validate(app.opt.case_dir, &error);
     else if (rc == 0 && !strcmp(command, "compare"))

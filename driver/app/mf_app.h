@@ -55,6 +55,22 @@ void mf_app_summary(const mf_app *app);
 /* output/runSummary: how the run ended (status is its return code). */
 int mf_write_run_summary(const mf_app *app, int status);
 
+/* The tables of compareDict and stabilityDict (runs.c, stability.c), and
+ * every table of every case dictionary and module (dict_tables.c): what
+ * `mpsflow modules controlDict|geometry|fluids|watch|validation|compareDict|
+ * stabilityDict` and `mpsflow reference` print. */
+extern const mf_param mf_compare_params[];
+extern const mf_param_section mf_compare_sections[];
+extern const size_t mf_compare_nsections;
+extern const mf_param_section mf_stability_sections[];
+extern const size_t mf_stability_nsections;
+/* Print the tables of the case dictionary `name` (false: no such one). */
+bool mf_dict_tables_print(const char *name, FILE *f);
+/* The names mf_dict_tables_print knows, NULL-terminated. */
+extern const char *const mf_dict_table_names[];
+/* docs/reference.md: every dictionary's and every module's keys. */
+int mf_cmd_reference(mf_registry *reg, const char *path);
+
 /* Commands. */
 int mf_cmd_run(mf_app *app);
 int mf_cmd_modules(mf_registry *reg, const char *name);

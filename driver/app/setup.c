@@ -210,7 +210,7 @@ int mf_app_setup(mf_app *app)
     MF_CALL(mf_scene_build_budgeted(app->cs.geometry, app->opt.l0, sim,
                                     mf_dict_set_subdict(resolved, "geometry"), &mesh_reader,
                                     &app->budget));
-    MF_CALL(mf_scene_check_overlap(sim));
+    MF_CALL(mf_scene_check_start(app->cs.geometry, sim));
     mf_dict *rf = mf_dict_set_subdict(resolved, "fluids");
     for (int k = 0; k < sim->nfluids; k++) {
         mf_dict *f = mf_dict_set_subdict(rf, sim->fluid[k].name);

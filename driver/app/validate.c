@@ -30,6 +30,12 @@ static const mf_metric *const metrics[] = {
 };
 #define NMETRICS (sizeof metrics / sizeof metrics[0])
 
+const mf_metric *const *mf_metric_list(size_t *n)
+{
+    *n = NMETRICS;
+    return metrics;
+}
+
 int mf_cmd_validate(const char *case_dir, double *error)
 {
     char path[4200];

@@ -332,7 +332,8 @@ static int laplace_evaluate(const char *case_dir, const mf_dict *md, double *err
 
 const mf_metric mf_metric_laplace = {"laplacePressure",
                                      "pressure jump of a droplet at rest against Laplace",
-                                     laplace_evaluate};
+                                     laplace_evaluate,
+    laplace_params, sizeof laplace_params / sizeof laplace_params[0]};
 
 /* ---- oscillationPeriod ------------------------------------------------------ */
 
@@ -469,7 +470,8 @@ static int osc_evaluate(const char *case_dir, const mf_dict *md, double *error)
 
 const mf_metric mf_metric_oscillation = {"oscillationPeriod",
                                          "mode-2 oscillation period of a drop against Rayleigh",
-                                         osc_evaluate};
+                                         osc_evaluate,
+    osc_params, sizeof osc_params / sizeof osc_params[0]};
 
 /* ---- layering ------------------------------------------------------------------ */
 
@@ -577,7 +579,8 @@ static int layer_evaluate(const char *case_dir, const mf_dict *md, double *error
 
 const mf_metric mf_metric_layering = {"layering",
                                       "two fluids settled: light above the interface height",
-                                      layer_evaluate};
+                                      layer_evaluate,
+    layer_params, sizeof layer_params / sizeof layer_params[0]};
 
 /* ---- rayleighTaylor -------------------------------------------------------------- */
 
@@ -683,7 +686,8 @@ static int rt_evaluate(const char *case_dir, const mf_dict *md, double *error)
 }
 
 const mf_metric mf_metric_rayleigh_taylor = {
-    "rayleighTaylor", "spike and bubble of a Rayleigh-Taylor instability", rt_evaluate};
+    "rayleighTaylor", "spike and bubble of a Rayleigh-Taylor instability", rt_evaluate,
+    rt_params, sizeof rt_params / sizeof rt_params[0]};
 
 /* ---- fluidSurgeFront ------------------------------------------------------------ */
 /* The dam-break front of one fluid among several (the water of a water/air
@@ -806,4 +810,5 @@ static int front_evaluate(const char *case_dir, const mf_dict *md, double *error
 }
 
 const mf_metric mf_metric_fluid_surge_front = {
-    "fluidSurgeFront", "dam-break surge front of one fluid among several", front_evaluate};
+    "fluidSurgeFront", "dam-break surge front of one fluid among several", front_evaluate,
+    front_params, sizeof front_params / sizeof front_params[0]};

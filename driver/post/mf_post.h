@@ -21,9 +21,13 @@ typedef struct mf_metric {
     const char *name;
     const char *summary;
     int (*evaluate)(const char *case_dir, const mf_dict *metric_dict, double *error);
+    const mf_param *params; /* the keys of validation/metric besides `metric` */
+    size_t nparams;
 } mf_metric;
 
 extern const mf_metric mf_metric_surge_front;
+/* Every metric `validate` knows (driver/app/validate.c). */
+const mf_metric *const *mf_metric_list(size_t *n);
 
 /* The surge front of a fluid particle set: the largest x - back_wall of a
  * particle with at least two neighbours within 2.1 l0 (lone splashes do not
