@@ -220,8 +220,8 @@ static bool domain_of(const mf_sim *sim, double mn[3], double mx[3])
     const mf_particles *p = sim->p;
     bool any = false;
     for (int a = 0; a < 3; a++) {
-        mn[a] = INFINITY;
-        mx[a] = -INFINITY;
+        mn[a] = a < sim->dim ? INFINITY : 0;
+        mx[a] = a < sim->dim ? -INFINITY : 0;
     }
     for (size_t i = 0; i < p->n_owned; i++) {
         if (p->kind[i] != MF_WALL && p->kind[i] != MF_DUMMY)

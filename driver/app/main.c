@@ -144,21 +144,23 @@ int mf_cmd_modules(mf_registry *reg, const char *name)
         return 0;
     const mf_module_info *m = mf_registry_lookup_any(reg, name);
     if (!m) {
-        /* Let the registry's error list every name of every kind. */
-        const mf_module_info *found;
-        int rc = mf_registry_find(reg, MF_KIND_SOLVER, name, &found);
-        for (int k = 1; k < MF_KIND_COUNT && rc != 0; k++) {
-            char first[2048];
-            snprintf(first, sizeof first, "%s", mf_error_message());
-            mf_error_clear();
-            rc = mf_registry_find(reg, (mf_module_kind)k, name, &found);
-            if (rc != 0) {
-                char both[4200];
-                snprintf(both, sizeof both, "%s; %s", first, mf_error_message());
-                rc = MF_ERROR(MF_ERR_INPUT, "%s", both);
-            }
+        /* Suggest from every module of every kind and the case dictionaries. */
+        const char *names[512];
+        size_t n = 0;
+        char list[4096] = "";
+        for (int k = 0; k < MF_KIND_COUNT; k++)
+            for (size_t i = 0; i < mf_registry_count(reg, (mf_module_kind)k) && n < 500; i++)
+                names[n++] = mf_registry_at(reg, (mf_module_kind)k, i)->name;
+        for (size_t k = 0; mf_dict_table_names[k] && n < 512; k++)
+            names[n++] = mf_dict_table_names[k];
+        for (size_t k = 0; k < n; k++) {
+            strncat(list, k ? ", " : "", sizeof list - strlen(list) - 1);
+            strncat(list, names[k], sizeof list - strlen(list) - 1);
         }
-        return MF_ERROR(MF_ERR_INPUT, "no module named '%s'. %s", name, mf_error_message());
+        const char *hint = mf_did_you_mean(name, names, n);
+        return MF_ERROR(MF_ERR_INPUT, "no module or case dictionary named '%s'%s%s%s; known: %s",
+                        name, hint ? " (did you mean '" : "", hint ? hint : "", hint ? "'?)" : "",
+                        list);
     }
     printf("%s (%s module): %s\n", m->name, mf_module_kind_name(m->kind), m->summary);
     printf("Parameters:\n");

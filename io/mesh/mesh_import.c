@@ -5,6 +5,7 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <errno.h>
+#include <inttypes.h>
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -82,10 +83,19 @@ int mf_mesh_import(const char *path, mf_trimesh *out)
     struct stat st;
     if (stat(path, &st) != 0)
         return MF_ERROR(MF_ERR_IO, "%s: cannot open (%s)", path, strerror(errno));
+    /* Only regular files, of a size known before assimp reads a byte: a FIFO
+     * would block, a device never end. */
     if (!S_ISREG(st.st_mode))
-        return MF_ERROR(MF_ERR_IO, "%s: not a regular file", path);
+        return MF_ERROR(MF_ERR_INPUT, "%s: is %s, not a regular file: not a polygon file", path,
+                        S_ISDIR(st.st_mode)    ? "a folder"
+                        : S_ISFIFO(st.st_mode) ? "a FIFO (named pipe)"
+                        : S_ISCHR(st.st_mode)  ? "a character device"
+                                               : "a special file");
     if (st.st_size == 0)
         return MF_ERROR(MF_ERR_INPUT, "%s: the file is empty (0 bytes)", path);
+    if ((uintmax_t)st.st_size > MF_MESH_MAX_FILE_BYTES)
+        return MF_ERROR(MF_ERR_INPUT, "%s: %jd bytes is more than the %zu GiB a polygon file may "
+                        "have here", path, (intmax_t)st.st_size, MF_MESH_MAX_FILE_BYTES >> 30);
     const struct aiScene *sc =
         aiImportFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
                                aiProcess_SortByPType);

@@ -12,7 +12,12 @@
 
 #include "mf_trimesh.h"
 
-/* Read the file at path into *out (initialised by the caller). */
+/* Polygon files larger than this are refused before they are read: 4 GiB
+ * is tens of millions of triangles, beyond what a scene's lattice can use. */
+#define MF_MESH_MAX_FILE_BYTES ((size_t)4 << 30)
+
+/* Read the file at path into *out (initialised by the caller); only a
+ * regular file, of at most MF_MESH_MAX_FILE_BYTES. */
 int mf_mesh_import(const char *path, mf_trimesh *out);
 
 /* The reader the scene builder takes: `file` as written in a case, tried
