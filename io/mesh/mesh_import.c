@@ -34,13 +34,20 @@ static int add_mesh(mf_trimesh *out, const struct aiMesh *am, const struct aiMat
     }
     for (unsigned f = 0; f < am->mNumFaces; f++) {
         const struct aiFace *face = &am->mFaces[f];
-        if (face->mNumIndices != 3) { /* points and lines (polygons are triangulated) */
+        if (face->mNumIndices < 3) { /* points and lines */
             out->dropped++;
             continue;
         }
-        MF_CALL(mf_trimesh_add_triangle(out, (int32_t)(base + face->mIndices[0]),
-                                        (int32_t)(base + face->mIndices[1]),
-                                        (int32_t)(base + face->mIndices[2])));
+        for (unsigned k = 0; k < face->mNumIndices; k++)
+            if (face->mIndices[k] >= am->mNumVertices)
+                return MF_ERROR(MF_ERR_INPUT, "%s: face %u names vertex %u of %u", out->name, f,
+                                face->mIndices[k] + 1, am->mNumVertices);
+        /* A polygon as a fan of triangles from its first corner: the faces of
+         * the files we read (quads, convex polygons) are split exactly. */
+        for (unsigned k = 1; k + 1 < face->mNumIndices; k++)
+            MF_CALL(mf_trimesh_add_triangle(out, (int32_t)(base + face->mIndices[0]),
+                                            (int32_t)(base + face->mIndices[k]),
+                                            (int32_t)(base + face->mIndices[k + 1])));
     }
     return 0;
 }
@@ -96,9 +103,12 @@ int mf_mesh_import(const char *path, mf_trimesh *out)
     if ((uintmax_t)st.st_size > MF_MESH_MAX_FILE_BYTES)
         return MF_ERROR(MF_ERR_INPUT, "%s: %jd bytes is more than the %zu GiB a polygon file may "
                         "have here", path, (intmax_t)st.st_size, MF_MESH_MAX_FILE_BYTES >> 30);
-    const struct aiScene *sc =
-        aiImportFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                               aiProcess_SortByPType);
+    /* No post-processing but validation: assimp's own triangulation stops
+     * the process (an assertion) on some broken files (found by fuzzing:
+     * an OFF file with a bad face line); polygons are split here instead,
+     * and corners merged by mf_trimesh_weld. Validation refuses indices out
+     * of range and the like with an error, not a crash. */
+    const struct aiScene *sc = aiImportFile(path, aiProcess_ValidateDataStructure);
     if (!sc)
         return MF_ERROR(MF_ERR_INPUT, "%s: not a polygon file assimp can read (%s)", path,
                         aiGetErrorString());
