@@ -161,7 +161,10 @@ static void land_on_target(const mf_run *run, double next_write, double *dt, dou
     const double left = target - sim->time;
     *land = NAN;
     if (left > 0 && *dt >= left * (1 - 1e-9)) {
-        *dt = left;
+        /* A fixed step that reaches the target but for rounding (k steps of
+         * deltaT to a write time) stays deltaT: only the time is set. */
+        if (run->ctl.adjust || fabs(*dt - left) > 1e-9 * *dt)
+            *dt = left;
         *land = target;
     } else if (left > 0 && run->ctl.adjust && *dt > 0.5 * left) {
         *dt = 0.5 * left; /* two even steps rather than a sliver */
