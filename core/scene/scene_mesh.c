@@ -858,7 +858,8 @@ int mf_scene_mesh_wall(mf_scene_meshes *sm, mf_sim *sim, const char *name, const
         keys[nkeys++] = b.key[e] | (wall ? 1ULL << 63 : 0);
     }
     if (rc == 0) {
-        qsort(keys, nkeys, sizeof *keys, cmp_u64);
+        if (nkeys > 1)
+            qsort(keys, nkeys, sizeof *keys, cmp_u64);
         for (size_t k = 0; rc == 0 && k < nkeys; k++) {
             int kind = keys[k] >> 63 ? MF_WALL : MF_DUMMY;
             rc = place_fixed(sm, sim, keys[k] & ~(1ULL << 63), kind, &nwall, &ndummy);
@@ -961,7 +962,8 @@ static int fill_points(const mesh_item *it, const lattice *L, int out_sign, cons
                                        delta};
             }
     }
-    qsort(cr, ncr, sizeof *cr, cmp_crossing);
+    if (ncr > 1) /* qsort may not be handed NULL, which cr is with no crossing */
+        qsort(cr, ncr, sizeof *cr, cmp_crossing);
     uint64_t *keys = NULL;
     size_t nkeys = 0, capk = 0;
     for (size_t s = 0; s < ncr;) {
