@@ -176,6 +176,11 @@ CATALOGUE = [
 # Entries whose first line depends on the machine (its memory) or on the
 # last digits of a solver's arithmetic: a pattern.
 PATTERNS = {
+    "missing plugin":
+        r"^--> mpsflow FATAL ERROR: cannot load plugin 'libnoSuchThing\.so' \(tried "
+        r"libnoSuchThing\.so, \{bin\}/\.\./plugins/libnoSuchThing\.so, .*\): .*cannot open shared "
+        r"object file: No such file or directory\. Set MPSFLOW_PLUGIN_PATH to the folder that "
+        r"holds it$",
     "solve not converging":
         r"^--> mpsflow FATAL ERROR: unstable \(pressureSolve\) at time 7\.5e-06, step 1: "
         r"PCG_BoomerAMG not converged after 2 iterations \(relative residual [0-9.e+-]+, from "
@@ -339,7 +344,7 @@ EXPECTED.update({
     'unknown module':
         "--> mpsflow FATAL ERROR: no module or case dictionary named 'MSP' (did you mean 'MPS'?); known: MPS, multiFluid, MAFL, PCG_BoomerAMG, PCG_diagonal, upwind, QUICK, gravity, surfaceTension, drag, surface, levelSet, blobby, hdf5, controlDict, watch, geometry, fluids, validation, compareDict, stabilityDict",
     'misspelt key':
-        "--> mpsflow FATAL ERROR: {case}/system/controlDict:15:1: unknown key 'endTme' in '(top level)' (did you mean 'endTime'?); valid keys: application, startTime, endTime, deltaT, adjustTimeStep, maxCo, maxDi, maxDeltaT, minDeltaT, writeControl, writeInterval, writer, startFrom, maxRetries, maxMemory, FoamFile, libs, functions, watch, writerCoeffs",
+        "--> mpsflow FATAL ERROR: {case}/system/controlDict:15:1: unknown key 'endTme' in '(top level)' (did you mean 'endTime'?); valid keys: application, startTime, endTime, deltaT, adjustTimeStep, maxCo, maxDi, maxDeltaT, minDeltaT, writeControl, writeInterval, writer, startFrom, maxRetries, maxMemory, stopAt, runTimeModifiable, purgeWrite, FoamFile, libs, functions, watch, writerCoeffs",
     'wrong type':
         "--> mpsflow FATAL ERROR: {case}/system/controlDict:15:9: key 'endTime': expected a number, found word 'abc'",
     'endTime missing':
@@ -380,8 +385,6 @@ EXPECTED.update({
         "--> mpsflow FATAL ERROR: unknown writer module 'vtk'; valid writer modules: hdf5",
     'libs not a list':
         '--> mpsflow FATAL ERROR: {case}/system/controlDict:25:1: \'libs\' takes a list, e.g. libs ("libprobes.so");',
-    'missing plugin':
-        "--> mpsflow FATAL ERROR: cannot load plugin 'libnoSuchThing.so' (tried libnoSuchThing.so, {bin}/../plugins/libnoSuchThing.so, {bin}/../lib/mpsflow/libnoSuchThing.so): {bin}/../lib/mpsflow/libnoSuchThing.so: cannot open shared object file: No such file or directory. Set MPSFLOW_PLUGIN_PATH to the folder that holds it",
     'function without type':
         "--> mpsflow FATAL ERROR: {case}/system/controlDict:29:5: missing key 'type' in dictionary 'functions/energy'",
     'unknown function type':

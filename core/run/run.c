@@ -1,5 +1,6 @@
 /* run.c: the time loop. */
 #include "mf_run.h"
+#include "mf_run_internal.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -226,6 +227,7 @@ static int write_now(mf_run *run)
             MF_CALL(fo->write(run->functions[k].data, run->sim));
     }
     run->writes++;
+    MF_CALL(mf_run_after_write(run));
     return 0;
 }
 
@@ -311,27 +313,17 @@ static int step_once(mf_run *run, saved_state *saved, double next_write)
     return 0;
 }
 
-/* Write times are k times the interval, k counted, never sums of the
- * interval: a run restarted at a write time finds the same next write time
- * to the bit as the run that wrote it (0.002 added nine times is not 9 x
- * 0.002, and the step that lands on it would differ). With writeControl
- * timeStep they are step counts. */
-static double first_write_time(const mf_run *run, double *k)
+/* The write time after `next_write`. Write times are k times the interval
+ * (mf_run_first_write), never sums of it: a run restarted at a write time
+ * finds the same next write time to the bit as the run that wrote it (0.002
+ * added nine times is not 9 x 0.002, and the step that lands on it would
+ * differ). With writeControl timeStep they are step counts, exact either way. */
+static double next_write_after(const mf_run *run, double next_write)
 {
     const double interval = run->ctl.write_interval;
-    const mf_sim *sim = run->sim;
-    if (run->ctl.write_by_steps) {
-        *k = floor((double)sim->step / interval) + 1;
-        return *k * interval;
-    }
-    *k = floor(sim->time / interval + 1e-9) + 1;
-    return *k * interval;
-}
-
-static double next_write_time(const mf_run *run, double *k)
-{
-    *k += 1;
-    return *k * run->ctl.write_interval;
+    if (run->ctl.write_by_steps)
+        return next_write + interval;
+    return (floor(next_write / interval + 0.5) + 1) * interval;
 }
 
 int mf_run_loop(mf_run *run, bool write_initial)
@@ -340,8 +332,8 @@ int mf_run_loop(mf_run *run, bool write_initial)
     saved_state saved;
     memset(&saved, 0, sizeof saved);
     const double t0 = mf_wall_seconds(), c0 = mf_cpu_seconds();
-    double write_index = 0;
-    double next_write = first_write_time(run, &write_index);
+    /* Next write time: the first multiple of the interval after now. */
+    double next_write = mf_run_first_write(run);
     int rc = 0;
     /* Inlets and outlets exchange energy with the outside (the inflow's
      * kinetic energy, the pressure work at the open ends) that the watch
@@ -383,15 +375,22 @@ int mf_run_loop(mf_run *run, bool write_initial)
         }
         bool write = run->ctl.write_by_steps ? (double)sim->step >= next_write - 0.5
                                              : sim->time >= next_write * (1 - 1e-9);
-        if (write || sim->time >= sim->end_time * (1 - 1e-12)) {
+        bool wrote = write || sim->time >= sim->end_time * (1 - 1e-12);
+        if (wrote) {
             MF_CALL_GOTO(rc, write_now(run), done);
             while (next_write <= (run->ctl.write_by_steps ? (double)sim->step : sim->time * (1 + 1e-9)))
-                next_write = next_write_time(run, &write_index);
+                next_write = next_write_after(run, next_write);
         }
         double wall = mf_wall_seconds() - t0;
         mf_log_printf(sim->log, MF_LOG_STEP, "ExecutionTime = %.3f s  ClockTime = %.0f s\n\n",
                       mf_cpu_seconds() - c0, wall);
         mf_log_progress(sim->log, sim->time, sim->end_time, wall);
+        bool stop = false, write_extra = false;
+        MF_CALL_GOTO(rc, mf_run_between_steps(run, wrote, &next_write, &stop, &write_extra), done);
+        if (write_extra)
+            MF_CALL_GOTO(rc, write_now(run), done);
+        if (stop)
+            break;
     }
     mf_log_progress_end(sim->log);
 done:

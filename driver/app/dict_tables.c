@@ -43,8 +43,8 @@ static void each_section(const char *name, section_fn fn, FILE *f)
         for (size_t k = 0; k < mf_fluid_nsections; k++)
             fn(&mf_fluid_sections[k], f);
     } else if (!strcmp(name, "validation")) {
-        size_t n = 0;
-        const mf_metric *const *m = mf_metric_list(&n);
+        const size_t n = mf_nmetrics;
+        const mf_metric *const *m = mf_metrics;
         for (size_t k = 0; k < n; k++) {
             char title[160];
             snprintf(title, sizeof title, "validation/metric: metric %s", m[k]->name);

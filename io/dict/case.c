@@ -14,6 +14,7 @@
 
 static const char *const write_controls[] = {"adjustableRunTime", "timeStep", NULL};
 static const char *const start_froms[] = {"startTime", "latestTime", NULL};
+static const char *const stop_ats[] = {"endTime", "writeNow", "noWriteNow", "nextWrite", NULL};
 
 /* Ranges: what the numerics allow, each said in its doc line (the key
  * reference, docs/reference.md, is generated from these). */
@@ -60,7 +61,16 @@ const mf_param mf_control_params[] = {
      "GB the scene may need by the memory estimate (particles times bytes a particle), "
      "checked before any particle is made; 0: 80% of this machine's memory (or of the "
      "cgroup's limit)"},
-    /* Run control of issue 15 (stopAt, runTimeModifiable, purgeWrite) goes here. */
+    /* ---- run control (issue 15; core/run/run_control.c) ---------------- */
+    {"stopAt", MF_PARAM_WORD, "endTime", MF_NO_RANGE, stop_ats, offsetof(mf_control, stop_at),
+     "endTime; writeNow / noWriteNow: stop after the current step with / without a snapshot; "
+     "nextWrite: after the next snapshot"},
+    {"runTimeModifiable", MF_PARAM_BOOL, "no", MF_NO_RANGE, NULL,
+     offsetof(mf_control, run_time_modifiable),
+     "re-read this file between steps when it changes (endTime, stopAt, writeInterval, "
+     "time-step limits, purgeWrite)"},
+    {"purgeWrite", MF_PARAM_INT, "0", 0, 1000000000, NULL, offsetof(mf_control, purge_write),
+     "keep only the newest N snapshots of this run, besides the initial one (0: keep all)"},
 };
 const size_t mf_control_nparams = sizeof mf_control_params / sizeof mf_control_params[0];
 
@@ -104,6 +114,16 @@ static int check_control(const mf_dict *d, const mf_control *c)
     return 0;
 }
 
+/* controlDict's keys into *c (resolved may be NULL). */
+static int apply_control(const mf_dict *d, mf_control *c, mf_dict *resolved)
+{
+    static const char *const extra[] = {"FoamFile", "libs", "functions", "watch", "writerCoeffs",
+                                        NULL};
+    MF_CALL(mf_params_apply(mf_control_params, mf_control_nparams, d, extra, c, resolved));
+    MF_CALL(check_control(d, c));
+    return 0;
+}
+
 int mf_case_read(const char *dir, mf_case *c)
 {
     memset(c, 0, sizeof *c);
@@ -117,11 +137,23 @@ int mf_case_read(const char *dir, mf_case *c)
     c->resolved = mf_dict_new("", NULL);
     if (!c->resolved)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory");
-    static const char *const extra[] = {"FoamFile", "libs", "functions", "watch", "writerCoeffs",
-                                        NULL};
-    MF_CALL(mf_params_apply(mf_control_params, mf_control_nparams, c->control_dict, extra,
-                            &c->control, mf_dict_set_subdict(c->resolved, "controlDict")));
-    MF_CALL(check_control(c->control_dict, &c->control));
+    MF_CALL(apply_control(c->control_dict, &c->control,
+                          mf_dict_set_subdict(c->resolved, "controlDict")));
+    return 0;
+}
+
+int mf_case_reread_control(const char *dir, mf_control *control, mf_dict **tree)
+{
+    mf_dict *d = NULL;
+    MF_CALL(read_one(dir, "system/controlDict", &d));
+    mf_control c;
+    int rc = apply_control(d, &c, NULL);
+    if (rc != 0) {
+        mf_dict_free(d);
+        return mf_error_trace(rc, __FILE__, __LINE__, __func__);
+    }
+    *control = c;
+    *tree = d;
     return 0;
 }
 

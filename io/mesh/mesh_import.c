@@ -18,6 +18,8 @@
 static int add_mesh(mf_trimesh *out, const struct aiMesh *am, const struct aiMatrix4x4 *t)
 {
     size_t base = out->nverts;
+    if ((am->mNumVertices && !am->mVertices) || (am->mNumFaces && !am->mFaces))
+        return MF_ERROR(MF_ERR_INPUT, "%s: a mesh without its vertex or face arrays", out->name);
     MF_CALL(mf_trimesh_reserve(out, base + am->mNumVertices, out->ntris + am->mNumFaces));
     for (unsigned v = 0; v < am->mNumVertices; v++) {
         const struct aiVector3D *p = &am->mVertices[v];
@@ -34,6 +36,8 @@ static int add_mesh(mf_trimesh *out, const struct aiMesh *am, const struct aiMat
     }
     for (unsigned f = 0; f < am->mNumFaces; f++) {
         const struct aiFace *face = &am->mFaces[f];
+        if (face->mNumIndices && !face->mIndices)
+            return MF_ERROR(MF_ERR_INPUT, "%s: face %u has no indices", out->name, f);
         if (face->mNumIndices < 3) { /* points and lines */
             out->dropped++;
             continue;
@@ -74,11 +78,14 @@ static int add_node(mf_trimesh *out, const struct aiScene *sc, const struct aiNo
         return MF_ERROR(MF_ERR_INPUT, "%s: scene graph nested more than 64 deep", out->name);
     struct aiMatrix4x4 t;
     mat_mul(parent, &node->mTransformation, &t);
+    if ((node->mNumMeshes && !node->mMeshes) || (node->mNumChildren && !node->mChildren))
+        return MF_ERROR(MF_ERR_INPUT, "%s: a scene node without its arrays", out->name);
     for (unsigned k = 0; k < node->mNumMeshes; k++)
-        if (node->mMeshes[k] < sc->mNumMeshes)
+        if (node->mMeshes[k] < sc->mNumMeshes && sc->mMeshes && sc->mMeshes[node->mMeshes[k]])
             MF_CALL(add_mesh(out, sc->mMeshes[node->mMeshes[k]], &t));
     for (unsigned k = 0; k < node->mNumChildren; k++)
-        MF_CALL(add_node(out, sc, node->mChildren[k], &t, depth + 1));
+        if (node->mChildren[k])
+            MF_CALL(add_node(out, sc, node->mChildren[k], &t, depth + 1));
     return 0;
 }
 
@@ -103,12 +110,12 @@ int mf_mesh_import(const char *path, mf_trimesh *out)
     if ((uintmax_t)st.st_size > MF_MESH_MAX_FILE_BYTES)
         return MF_ERROR(MF_ERR_INPUT, "%s: %jd bytes is more than the %zu GiB a polygon file may "
                         "have here", path, (intmax_t)st.st_size, MF_MESH_MAX_FILE_BYTES >> 30);
-    /* No post-processing but validation: assimp's own triangulation stops
-     * the process (an assertion) on some broken files (found by fuzzing:
-     * an OFF file with a bad face line); polygons are split here instead,
-     * and corners merged by mf_trimesh_weld. Validation refuses indices out
-     * of range and the like with an error, not a crash. */
-    const struct aiScene *sc = aiImportFile(path, aiProcess_ValidateDataStructure);
+    /* No post-processing: assimp's own triangulation stops the process (an
+     * assertion) on some broken files (found by fuzzing: an OFF file with a
+     * bad face line). Polygons are split here instead (add_mesh, which also
+     * checks every index), corners merged by mf_trimesh_weld; points and
+     * lines are counted, and refused by the scene builder. */
+    const struct aiScene *sc = aiImportFile(path, 0);
     if (!sc)
         return MF_ERROR(MF_ERR_INPUT, "%s: not a polygon file assimp can read (%s)", path,
                         aiGetErrorString());
