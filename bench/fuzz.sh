@@ -31,11 +31,8 @@ for t in $targets; do
     # MPI keeps allocations for the life of the process: no leak check for
     # the case reader, which starts it.
     leaks=1; [ "$t" = case ] && leaks=0
-    # The mesh harness needs full unwinding to match the assimp suppression
-    # of tests/lsan.supp.
-    unwind=1; [ "$t" = mesh ] && unwind=0
     LSAN_OPTIONS="suppressions=$PWD/tests/lsan.supp:print_suppressions=0" \
-    ASAN_OPTIONS=detect_leaks=$leaks:fast_unwind_on_malloc=$unwind nice -n 19 build-fuzz/tests/fuzz/fuzz_$t \
+    ASAN_OPTIONS=detect_leaks=$leaks nice -n 19 build-fuzz/tests/fuzz/fuzz_$t \
         -max_total_time="$secs" -timeout=20 -rss_limit_mb=2560 -max_len=8192 \
         -print_final_stats=1 -artifact_prefix="$work/artifacts/" \
         "$work/corpus" "tests/fuzz/corpus/$t" > "$work/log" 2>&1
