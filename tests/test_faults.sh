@@ -30,6 +30,12 @@ fresh() {
     sed -i 's/^writeInterval .*/writeInterval 0.002;/; s/^endTime .*/endTime 0.2;/' "$dir/$1/system/controlDict"
 }
 header() { h5dump -m '%.17g' -a "/Header/$2" "$1" 2> /dev/null | sed -n 's/^ *(0): //p'; }
+# How to go on after a kill: restart from the newest snapshot; with none
+# yet, start afresh over what the killed run began (-overwrite).
+resume_args() {
+    if ls "$1"/output/snapshot_*.h5 > /dev/null 2>&1; then echo -latestTime
+    elif [ -d "$1/output" ]; then echo -overwrite; fi
+}
 # is X Y: the doubles X and Y are equal (exactly).
 is() { python3 -c "import sys; sys.exit(float('$1') != float('$2'))" 2> /dev/null; }
 last_snapshot() { ls "$1"/output/snapshot_*.h5 2> /dev/null | tail -1; }
@@ -88,7 +94,7 @@ print(' '.join('%.3f' % r.uniform(0.05, $span) for _ in range(10)))" > "$dir/mom
 k=0
 for moment in $(cat "$dir/moments"); do
     k=$((k + 1))
-    args=""; [ -e "$dir/killed/output/particles.xdmf" ] && args="-latestTime"
+    args=$(resume_args "$dir/killed")
     "$mpsflow" -case "$dir/killed" -l0 0.02 $args > "$dir/killed$k.log" 2>&1 &
     pid=$!
     sleep "$moment"
@@ -103,7 +109,7 @@ for moment in $(cat "$dir/moments"); do
     fi
 done
 stale=$(ls "$dir"/killed/output/*.tmp 2> /dev/null | wc -l)
-args=""; [ -e "$dir/killed/output/particles.xdmf" ] && args="-latestTime"
+args=$(resume_args "$dir/killed")
 "$mpsflow" -case "$dir/killed" -l0 0.02 $args > "$dir/killed-final.log" 2>&1; rc=$?
 [ $rc -eq 0 ] && ok "the last restart ran to the end" || { bad "the last restart exited with $rc"; tail -5 "$dir/killed-final.log"; }
 if [ "$stale" -gt 0 ]; then
