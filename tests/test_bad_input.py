@@ -144,6 +144,9 @@ CATALOGUE = [
     ("mesh file empty", "channelInflow", [("write", "constant/step.obj", "")], DRY),
     ("mesh file a FIFO", "channelInflow", [("rm", "constant/step.obj"), ("fifo", "constant/step.obj")],
      DRY),
+    ("mesh in an unread format", "channelInflow",
+     [("write", "constant/step.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"),
+      ("sub", GEO, r'file        "step.obj";', 'file "step.off";')], DRY),
     ("OBJ cut mid-face", "boxFilling", [("trunc", "constant/triSurface/box.obj", -4)], DRY),
     ("mesh in millimetres", "boxFilling", [("sub", GEO, r'file        "box.obj";', 'file "box.obj"; scale 1000;')],
      DRY),
@@ -491,6 +494,8 @@ EXPECTED.update({
         "--> mpsflow FATAL ERROR: {case}/constant/geometry:38:9: wall 'channel': {case}/constant/step.obj: the file is empty (0 bytes)",
     'mesh file a FIFO':
         "--> mpsflow FATAL ERROR: {case}/constant/geometry:38:9: wall 'channel': {case}/constant/step.obj: is a FIFO (named pipe), not a regular file: not a polygon file",
+    'mesh in an unread format':
+        "--> mpsflow FATAL ERROR: {case}/constant/geometry:38:9: wall 'channel': {case}/constant/step.off: not a polygon format read here (the name must end in .obj, .stl or .ply; convert the file, e.g. with meshlab or Blender)",
     'OBJ cut mid-face':
         "--> mpsflow FATAL ERROR: {case}/constant/geometry:26:9: wall 'box': {case}/constant/triSurface/box.obj holds 1 points or lines beside its triangles (a file cut short in the middle of a face, or edges drawn in it); only triangles and polygons make surfaces: repair or re-export the file",
     'mesh in millimetres':

@@ -9,6 +9,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 
 #include "mf_error.h"
@@ -89,11 +90,33 @@ static int add_node(mf_trimesh *out, const struct aiScene *sc, const struct aiNo
     return 0;
 }
 
+/* The formats read: assimp reads dozens, and some of its readers crash on a
+ * broken file (its OFF reader read out of bounds on a face list longer than
+ * the file, found by fuzzing, and that inside the library, where no check of
+ * ours can reach). These three are what polygon geometry for a scene comes
+ * in, and the fuzz_mesh harness tries them. */
+static const char *const formats[] = {"obj", "stl", "ply"};
+
+static int check_format(const char *path)
+{
+    const char *dot = strrchr(path, '.');
+    const char *slash = strrchr(path, '/');
+    if (dot && (!slash || dot > slash))
+        for (size_t k = 0; k < sizeof formats / sizeof formats[0]; k++)
+            if (strcasecmp(dot + 1, formats[k]) == 0)
+                return 0;
+    return MF_ERROR(MF_ERR_INPUT,
+                    "%s: not a polygon format read here (the name must end in .obj, .stl or "
+                    ".ply; convert the file, e.g. with meshlab or Blender)",
+                    path);
+}
+
 int mf_mesh_import(const char *path, mf_trimesh *out)
 {
     size_t len = strlen(path) < sizeof out->name - 1 ? strlen(path) : sizeof out->name - 1;
     memcpy(out->name, path, len);
     out->name[len] = '\0';
+    MF_CALL(check_format(path));
     struct stat st;
     if (stat(path, &st) != 0)
         return MF_ERROR(MF_ERR_IO, "%s: cannot open (%s)", path, strerror(errno));

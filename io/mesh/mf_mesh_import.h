@@ -1,5 +1,6 @@
-/* mf_mesh_import.h: polygon files (OBJ, STL, PLY, OFF and whatever else
- * Debian's assimp reads) into the plain triangle mesh of core/scene/mf_trimesh.h.
+/* mf_mesh_import.h: polygon files (OBJ, STL and PLY, through Debian's
+ * assimp; other formats are refused: some of assimp's readers crash on
+ * broken files) into the plain triangle mesh of core/scene/mf_trimesh.h.
  *
  * Polygons are split into triangles; points and lines are counted in
  * mesh->dropped and left out; node transforms of formats that have them
