@@ -129,16 +129,47 @@ static int diagnose_collapse(const mf_sim *sim, double dt, double floor_dt, cons
                     x[2], sqrt(u2max));
 }
 
+/* The time the step must not pass: the next write time (adjustableRunTime)
+ * or the end. A step within a hair of it (relative 1e-9, far above the
+ * rounding of sums of steps) is shortened to end there, and the time is then
+ * set to the target itself, not to time + dt: a fixed step, or one chosen by
+ * the limits, lands exactly on endTime and on every write time. *land is
+ * the target when the step lands on it, NAN otherwise. */
+static void land_on_target(const mf_run *run, double next_write, double *dt, double *land)
+{
+    const mf_sim *sim = run->sim;
+    double target = sim->end_time;
+    /* An end time that is a write time (0.018 and 9 x 0.002 differ in the
+     * last bit) ends on the write time: a run stopped there and restarted
+     * then takes the steps of the run that went on through it. */
+    if (!run->ctl.write_by_steps &&
+        (next_write < target || fabs(next_write - target) <= 1e-9 * target))
+        target = next_write;
+    const double left = target - sim->time;
+    *land = NAN;
+    if (left > 0 && *dt >= left * (1 - 1e-9)) {
+        /* A fixed step that reaches the target but for rounding (k steps of
+         * deltaT to a write time) stays deltaT: only the time is set. */
+        if (run->ctl.adjust || fabs(*dt - left) > 1e-9 * *dt)
+            *dt = left;
+        *land = target;
+    } else if (left > 0 && run->ctl.adjust && *dt > 0.5 * left) {
+        *dt = 0.5 * left; /* two even steps rather than a sliver */
+    }
+}
+
 /* The step the limits allow ("natural"), then shortened to land on the next
  * write time or the end. Growth is limited relative to the last natural
  * step, so a sliver taken to land on a write time does not hold dt down. */
-static int choose_dt(mf_run *run, double next_write, double *dt, const char **limiter)
+static int choose_dt(mf_run *run, double next_write, double *dt, const char **limiter,
+                     double *land)
 {
     mf_sim *sim = run->sim;
     const mf_run_control *c = &run->ctl;
     if (!c->adjust) {
         *dt = c->delta_t;
         *limiter = "fixed";
+        land_on_target(run, next_write, dt, land);
     } else {
         mf_dt_choice ch;
         mf_dt_choose(sim->l0, mf_max_fluid_speed(sim->p), c->max_co,
@@ -163,15 +194,7 @@ static int choose_dt(mf_run *run, double next_write, double *dt, const char **li
         }
         run->sim->dt_natural = natural;
         *dt = natural;
-        /* Land on write times and the end time (adjustableRunTime). */
-        double target = sim->end_time;
-        if (!c->write_by_steps && next_write < target)
-            target = next_write;
-        double left = target - sim->time;
-        if (left > 0 && *dt >= left * (1 - 1e-9))
-            *dt = left;
-        else if (left > 0 && *dt > 0.5 * left)
-            *dt = 0.5 * left; /* two even steps rather than a sliver */
+        land_on_target(run, next_write, dt, land);
     }
     if (!(*dt > 0) || !isfinite(*dt))
         return MF_ERROR(MF_ERR_NUMERIC, "the time step became %g at time %g", *dt, sim->time);
@@ -217,9 +240,9 @@ static int apply_emitters(mf_run *run, double dt, double *kinetic_in, size_t *ad
 static int step_once(mf_run *run, saved_state *saved, double next_write)
 {
     mf_sim *sim = run->sim;
-    double dt = 0;
+    double dt = 0, land = NAN;
     const char *limiter = NULL;
-    MF_CALL(choose_dt(run, next_write, &dt, &limiter));
+    MF_CALL(choose_dt(run, next_write, &dt, &limiter, &land));
     MF_CALL(save_state(saved, sim->p, sim->time));
     const double work0 = run->watch.work;
     size_t added = 0, removed = 0;
@@ -261,6 +284,7 @@ static int step_once(mf_run *run, saved_state *saved, double next_write)
         sim->time = saved->time;
         run->retries++;
         dt *= 0.5;
+        land = NAN; /* half the step no longer reaches the target */
         run->sim->dt_natural = dt;
     }
     (void)limiter;
@@ -269,7 +293,7 @@ static int step_once(mf_run *run, saved_state *saved, double next_write)
         sim->emitters->total_removed += removed;
     }
     mf_watch_accept(&run->watch);
-    sim->time += dt;
+    sim->time = isnan(land) ? sim->time + dt : land;
     sim->step++;
     run->steps++;
     for (size_t k = 0; k < run->nfunctions; k++) {
@@ -277,6 +301,19 @@ static int step_once(mf_run *run, saved_state *saved, double next_write)
         MF_CALL(fo->execute(run->functions[k].data, sim));
     }
     return 0;
+}
+
+/* The write time after `next_write`. Write times are k times the interval
+ * (mf_run_first_write), never sums of it: a run restarted at a write time
+ * finds the same next write time to the bit as the run that wrote it (0.002
+ * added nine times is not 9 x 0.002, and the step that lands on it would
+ * differ). With writeControl timeStep they are step counts, exact either way. */
+static double next_write_after(const mf_run *run, double next_write)
+{
+    const double interval = run->ctl.write_interval;
+    if (run->ctl.write_by_steps)
+        return next_write + interval;
+    return (floor(next_write / interval + 0.5) + 1) * interval;
 }
 
 int mf_run_loop(mf_run *run, bool write_initial)
@@ -342,7 +379,7 @@ int mf_run_loop(mf_run *run, bool write_initial)
         if (wrote) {
             MF_CALL_GOTO(rc, write_now(run), done);
             while (next_write <= (run->ctl.write_by_steps ? (double)sim->step : sim->time * (1 + 1e-9)))
-                next_write += run->ctl.write_interval;
+                next_write = next_write_after(run, next_write);
         }
         double wall = mf_wall_seconds() - t0;
         mf_log_printf(sim->log, MF_LOG_STEP, "ExecutionTime = %.3f s  ClockTime = %.0f s\n\n",

@@ -8,6 +8,7 @@
 
 #include "mf_error.h"
 #include "mf_modules.h"
+#include "mf_scene.h"
 
 const mf_param mf_watch_params[] = {
     {"enabled", MF_PARAM_BOOL, "yes", MF_NO_RANGE, NULL, offsetof(mf_watch_settings, enabled),
@@ -58,42 +59,25 @@ static int check_non_finite(const mf_sim *sim)
 }
 
 /* A fluid centre past the wall-particle line (l0/2 outside the enclosed
- * region) of a closed face, within that face's extent, went through it. */
+ * region) of a closed face, within that face's extent, went through it
+ * (mf_scene_past_wall: the dry run refuses a scene that starts so). */
 static int check_walls(const mf_sim *sim)
 {
     const mf_particles *p = sim->p;
-    const double h = 0.5 * sim->l0;
-    for (size_t b = 0; b < sim->nwall_boxes; b++) {
-        const mf_wall_box *box = &sim->wall_boxes[b];
-        for (size_t i = 0; i < p->n_owned; i++) {
-            if (p->kind[i] != MF_FLUID)
-                continue;
-            const double *x = &p->pos[3 * i];
-            for (int a = 0; a < sim->dim; a++) {
-                for (int side = 0; side < 2; side++) {
-                    if (box->open[a][side])
-                        continue;
-                    bool past = side == 0 ? x[a] < box->min[a] - h : x[a] > box->max[a] + h;
-                    if (!past)
-                        continue;
-                    bool within = true;
-                    for (int o = 0; o < sim->dim; o++)
-                        if (o != a && (x[o] < box->min[o] - h || x[o] > box->max[o] + h))
-                            within = false;
-                    if (!within)
-                        continue;
-                    static const char *const faces[3][2] = {
-                        {"xmin", "xmax"}, {"ymin", "ymax"}, {"zmin", "zmax"}};
-                    return MF_ERROR(MF_ERR_NUMERIC,
-                                    "unstable (throughWall) at time %g, step %ld: fluid particle "
-                                    "id %lld at (%g %g %g) is past the %s wall of wall box %zu, "
-                                    "moving at (%g %g %g) m/s",
-                                    sim->time, sim->step, (long long)p->id[i], x[0], x[1], x[2],
-                                    faces[a][side], b + 1, p->vel[3 * i], p->vel[3 * i + 1],
-                                    p->vel[3 * i + 2]);
-                }
-            }
-        }
+    static const char *const faces[3][2] = {{"xmin", "xmax"}, {"ymin", "ymax"}, {"zmin", "zmax"}};
+    for (size_t i = 0; i < p->n_owned; i++) {
+        size_t b;
+        int a, side;
+        if (p->kind[i] != MF_FLUID || !mf_scene_past_wall(sim, i, &b, &a, &side))
+            continue;
+        const double *x = &p->pos[3 * i];
+        return MF_ERROR(MF_ERR_NUMERIC,
+                        "unstable (throughWall) at time %g, step %ld: fluid particle "
+                        "id %lld at (%g %g %g) is past the %s wall of wall box %zu, "
+                        "moving at (%g %g %g) m/s",
+                        sim->time, sim->step, (long long)p->id[i], x[0], x[1], x[2],
+                        faces[a][side], b + 1, p->vel[3 * i], p->vel[3 * i + 1],
+                        p->vel[3 * i + 2]);
     }
     return 0;
 }

@@ -6,6 +6,7 @@
  *   mpsflow -version
  */
 #include <limits.h>
+#include <math.h>
 #include <mpi.h>
 #include <HYPRE_utilities.h>
 #include <stdlib.h>
@@ -24,6 +25,9 @@ static void usage(FILE *f)
             "Commands:\n"
             "  (none)            run the case\n"
             "  modules [NAME]    list the registered modules by kind, or the parameters of one\n"
+            "                    (also of a case dictionary: controlDict, watch, geometry,\n"
+            "                    fluids, validation, compareDict, stabilityDict)\n"
+            "  reference [FILE]  every key of every dictionary and module, as markdown\n"
             "  validate          score the case's output against its reference (validation/)\n"
             "  compare           run the case with several schemes and resolutions: error\n"
             "                    against run time (-solvers '(A B)' -resolutions '(l0 ...)')\n"
@@ -66,8 +70,8 @@ static int parse_number(const char *opt, const char *text, double *out)
 {
     char *end;
     *out = strtod(text, &end);
-    if (end == text || *end || !(*out > 0))
-        return MF_ERROR(MF_ERR_INPUT, "%s takes a positive number, not '%s'", opt, text);
+    if (end == text || *end || !(*out > 0) || !isfinite(*out))
+        return MF_ERROR(MF_ERR_INPUT, "%s takes a positive finite number, not '%s'", opt, text);
     return 0;
 }
 
@@ -167,25 +171,33 @@ int mf_cmd_modules(mf_registry *reg, const char *name)
 {
     if (!name) {
         mf_registry_print(reg, stdout);
+        printf("case dictionaries (mpsflow modules NAME):\n   ");
+        for (size_t k = 0; mf_dict_table_names[k]; k++)
+            printf(" %s", mf_dict_table_names[k]);
+        printf("\n");
         return 0;
     }
+    if (mf_dict_tables_print(name, stdout))
+        return 0;
     const mf_module_info *m = mf_registry_lookup_any(reg, name);
     if (!m) {
-        /* Let the registry's error list every name of every kind. */
-        const mf_module_info *found;
-        int rc = mf_registry_find(reg, MF_KIND_SOLVER, name, &found);
-        for (int k = 1; k < MF_KIND_COUNT && rc != 0; k++) {
-            char first[2048];
-            snprintf(first, sizeof first, "%s", mf_error_message());
-            mf_error_clear();
-            rc = mf_registry_find(reg, (mf_module_kind)k, name, &found);
-            if (rc != 0) {
-                char both[4200];
-                snprintf(both, sizeof both, "%s; %s", first, mf_error_message());
-                rc = MF_ERROR(MF_ERR_INPUT, "%s", both);
-            }
+        /* Suggest from every module of every kind and the case dictionaries. */
+        const char *names[512];
+        size_t n = 0;
+        char list[4096] = "";
+        for (int k = 0; k < MF_KIND_COUNT; k++)
+            for (size_t i = 0; i < mf_registry_count(reg, (mf_module_kind)k) && n < 500; i++)
+                names[n++] = mf_registry_at(reg, (mf_module_kind)k, i)->name;
+        for (size_t k = 0; mf_dict_table_names[k] && n < 512; k++)
+            names[n++] = mf_dict_table_names[k];
+        for (size_t k = 0; k < n; k++) {
+            strncat(list, k ? ", " : "", sizeof list - strlen(list) - 1);
+            strncat(list, names[k], sizeof list - strlen(list) - 1);
         }
-        return MF_ERROR(MF_ERR_INPUT, "no module named '%s'. %s", name, mf_error_message());
+        const char *hint = mf_did_you_mean(name, names, n);
+        return MF_ERROR(MF_ERR_INPUT, "no module or case dictionary named '%s'%s%s%s; known: %s",
+                        name, hint ? " (did you mean '" : "", hint ? hint : "", hint ? "'?)" : "",
+                        list);
     }
     printf("%s (%s module): %s\n", m->name, mf_module_kind_name(m->kind), m->summary);
     printf("Parameters:\n");
@@ -201,6 +213,8 @@ int mf_cmd_run(mf_app *app)
         printf("\nDry run: stopping before the time loop.\nEnd\n");
         return 0;
     }
+    int stale = 0;
+    MF_CALL(mf_app_remove_stale_tmp(app->cs.dir, &app->log, &stale));
     bool restart = mf_app_is_restart(app);
     if (restart) {
         const mf_writer_ops *w = (const mf_writer_ops *)app->writer.info;
@@ -283,7 +297,8 @@ int main(int argc, char **argv)
     if (command && !strcmp(command, "surface"))
         return mf_main_surface(argc, argv, first);
     const char *module_name = NULL;
-    if (command && !strcmp(command, "modules") && argc > 2 && argv[2][0] != '-') {
+    if (command && (!strcmp(command, "modules") || !strcmp(command, "reference")) && argc > 2 &&
+        argv[2][0] != '-') {
         module_name = argv[2];
         first = 3;
     }
@@ -301,7 +316,7 @@ int main(int argc, char **argv)
         return 0;
     }
     static const char *const commands[] = {"modules", "validate", "compare", "stability",
-                                           "listTimes"};
+                                           "listTimes", "reference"};
     const size_t ncommands = sizeof commands / sizeof commands[0];
     bool known = !command;
     for (size_t k = 0; k < ncommands && !known; k++)
@@ -333,6 +348,8 @@ int main(int argc, char **argv)
         rc = mf_cmd_list_times(&app.opt);
     else if (rc == 0 && !strcmp(command, "modules"))
         rc = mf_cmd_modules(app.reg, module_name);
+    else if (rc == 0 && !strcmp(command, "reference"))
+        rc = mf_cmd_reference(app.reg, module_name);
     else if (rc == 0 && !strcmp(command, "validate"))
         rc = mf_cmd_validate(app.opt.case_dir, &error);
     else if (rc == 0 && !strcmp(command, "compare"))

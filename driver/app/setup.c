@@ -210,13 +210,17 @@ int mf_app_setup(mf_app *app)
     MF_CALL(mf_app_load_case_libs(app));
     const mf_control *c = &app->cs.control;
     sim->time = c->start_time;
+    if (app->opt.end_time > 0)
+        MF_CALL(mf_case_check_end_time(c, app->opt.end_time, "-endTime"));
     sim->end_time = app->opt.end_time > 0 ? app->opt.end_time : c->end_time;
     MF_CALL(mf_scene_read_fluids(app->cs.fluids, sim));
     mf_dict *resolved = app->cs.resolved;
     const mf_trimesh_reader mesh_reader = mf_mesh_import_reader(); /* polygon files */
-    MF_CALL(mf_scene_build_with_reader(app->cs.geometry, app->opt.l0, sim,
-                                       mf_dict_set_subdict(resolved, "geometry"), &mesh_reader));
-    MF_CALL(mf_scene_check_overlap(sim));
+    MF_CALL(mf_app_memory_budget(app, &app->budget));
+    MF_CALL(mf_scene_build_budgeted(app->cs.geometry, app->opt.l0, sim,
+                                    mf_dict_set_subdict(resolved, "geometry"), &mesh_reader,
+                                    &app->budget));
+    MF_CALL(mf_scene_check_start(app->cs.geometry, sim));
     mf_dict *rf = mf_dict_set_subdict(resolved, "fluids");
     for (int k = 0; k < sim->nfluids; k++) {
         mf_dict *f = mf_dict_set_subdict(rf, sim->fluid[k].name);
@@ -314,4 +318,9 @@ void mf_app_summary(const mf_app *app)
     printf("Solver %s; time %g to %g s\n", app->solver.info->name, sim->time, sim->end_time);
     printf("Memory: particles %.2f MB; peak resident %.1f MB\n",
            mf_particles_memory(sim->p) / 1048576.0, mf_peak_memory() / 1048576.0);
+    const mf_scene_budget *b = &app->budget;
+    if (b->bytes_per_particle > 0)
+        printf("Memory estimate: %.3g particles x %.0f bytes = %.3g GB of maxMemory %.3g GB (%s)\n",
+               b->particles, b->bytes_per_particle, b->particles * b->bytes_per_particle / 1e9,
+               b->max_bytes / 1e9, b->limit_source);
 }
