@@ -371,7 +371,7 @@ static void check_dt_limit(const char *exe, const char *plugin_dir, mf_registry 
                  5 * 2 * limit, 2 * limit);
     else /* starts at a tenth of the limit, grows 20% a step: there by step 13 */
         snprintf(control, sizeof control,
-                 "endTime %.17g;\nadjustTimeStep yes;\ndeltaT %.17g;\nmaxCo 5;\nmaxDeltaT 1;\n"
+                 "endTime %.17g;\nadjustTimeStep yes;\ndeltaT %.17g;\nmaxCo 1;\nmaxDeltaT 1;\n"
                  "writeInterval 1;\nlibs (\"libfaultInjection.so\");\n",
                  25 * limit, 0.1 * limit);
     snprintf(solv, sizeof solv,
