@@ -143,7 +143,6 @@ struct mf_amg_vcycle {
     mf_split_csr fine; /* the matrix of the current solve */
     double *work[3];   /* PCG vectors (z, p, q) */
     size_t work_n;
-    size_t bytes;
 };
 
 void mf_amg_vcycle_free(mf_amg_vcycle *v)
@@ -166,17 +165,6 @@ void mf_amg_vcycle_free(mf_amg_vcycle *v)
     for (int k = 0; k < 3; k++)
         free(v->work[k]);
     free(v);
-}
-
-int64_t mf_amg_vcycle_fine_rows(const mf_amg_vcycle *v)
-{
-    return v->lev[0].n;
-}
-
-size_t mf_amg_vcycle_bytes(const mf_amg_vcycle *v)
-{
-    return v->bytes + 3 * v->work_n * sizeof(double) + v->fine.cap_rows * 32 +
-           v->fine.cap_nnz * 12;
 }
 
 /* The cycle hypre would run is the one written here: a V-cycle with one
@@ -247,7 +235,7 @@ static int copy_matrix(mf_split_csr *s, hypre_ParCSRMatrix *A)
     return rc;
 }
 
-int mf_amg_vcycle_copy(HYPRE_Solver amg, mf_amg_vcycle **out)
+int mf_amg_vcycle_take(HYPRE_Solver amg, mf_amg_vcycle **out)
 {
     _Static_assert(sizeof(HYPRE_Int) == sizeof(int32_t) && sizeof(HYPRE_Real) == sizeof(double),
                    "the copy takes hypre's arrays as int32_t and double");
@@ -257,8 +245,9 @@ int mf_amg_vcycle_copy(HYPRE_Solver amg, mf_amg_vcycle **out)
     if (nlevels < 2 || !cycle_is_ours(d))
         return 0;
     hypre_ParCSRMatrix **A = hypre_ParAMGDataAArray(d), **P = hypre_ParAMGDataPArray(d);
+    /* Level 0 is the caller's matrix (not read here: it may be gone). */
     for (int l = 0; l < nlevels; l++) {
-        if (hypre_CSRMatrixNumNonzeros(hypre_ParCSRMatrixOffd(A[l])) != 0 ||
+        if ((l > 0 && hypre_CSRMatrixNumNonzeros(hypre_ParCSRMatrixOffd(A[l])) != 0) ||
             (l + 1 < nlevels && hypre_CSRMatrixNumNonzeros(hypre_ParCSRMatrixOffd(P[l])) != 0))
             return 0; /* several ranks */
     }
@@ -275,10 +264,18 @@ int mf_amg_vcycle_copy(HYPRE_Solver amg, mf_amg_vcycle **out)
     v->nlevels = nlevels;
     for (int l = 0; l < nlevels; l++) {
         amg_level *L = &v->lev[l];
-        if (l + 1 < nlevels)
+        if (l + 1 < nlevels) {
             MF_CALL_GOTO(rc, copy_interp(L, P[l]), fail);
+            /* hypre's copy goes as soon as ours is made, so that the two
+             * hierarchies are not held whole at once (hypre_BoomerAMGDestroy
+             * skips the NULL entries). */
+            hypre_ParCSRMatrixDestroy(P[l]);
+            P[l] = NULL;
+        }
         if (l > 0) {
             MF_CALL_GOTO(rc, copy_matrix(&L->A, A[l]), fail);
+            hypre_ParCSRMatrixDestroy(A[l]);
+            A[l] = NULL;
             L->n = L->A.n;
             L->f = malloc(((size_t)L->n + 1) * sizeof *L->f);
             L->u = malloc(((size_t)L->n + 1) * sizeof *L->u);
@@ -286,10 +283,7 @@ int mf_amg_vcycle_copy(HYPRE_Solver amg, mf_amg_vcycle **out)
                 rc = MF_ERROR(MF_ERR_MEMORY, "out of memory for the AMG work vectors");
                 goto fail;
             }
-            v->bytes += (size_t)L->A.ptr[L->n] * 12 + (size_t)L->n * 44;
         }
-        if (l + 1 < nlevels)
-            v->bytes += (size_t)L->pptr[L->n] * 12 + (size_t)L->n * 4;
     }
 
     /* The coarsest level, dense, factorised once. */
@@ -313,7 +307,6 @@ int mf_amg_vcycle_copy(HYPRE_Solver amg, mf_amg_vcycle **out)
             mf_amg_vcycle_free(v);
             return 0;
         }
-        v->bytes += (size_t)nc * nc * sizeof *v->lu;
     }
     *out = v;
     return 0;
@@ -399,9 +392,9 @@ void mf_amg_vcycle_apply(mf_amg_vcycle *v, const mf_split_csr *A0, const int64_t
 
 /* ---- PCG ------------------------------------------------------------------ */
 
-int mf_amg_pcg(mf_amg_vcycle *v, const mf_csr *A_in, const int64_t *prow, double *x, double *r,
-               double bnorm, double tol, long max_iter, mf_residual_fn resid, const void *ctx,
-               int *iterations, double *rel)
+static int pcg_run(mf_amg_vcycle *v, const mf_csr *A_in, const int64_t *prow, double *x,
+                   double *r, double bnorm, double tol, long max_iter, mf_residual_fn resid,
+                   const void *ctx, int *iterations, double *rel)
 {
     const size_t n = A_in->nrows;
     *iterations = 0;
@@ -463,4 +456,15 @@ int mf_amg_pcg(mf_amg_vcycle *v, const mf_csr *A_in, const int64_t *prow, double
     }
     *rel = resid(ctx, x, r) / bnorm;
     return MF_RETRY;
+}
+
+int mf_amg_pcg(mf_amg_vcycle *v, const mf_csr *A, const int64_t *prow, double *x, double *r,
+               double bnorm, double tol, long max_iter, mf_residual_fn resid, const void *ctx,
+               int *iterations, double *rel)
+{
+    int rc = pcg_run(v, A, prow, x, r, bnorm, tol, max_iter, resid, ctx, iterations, rel);
+    /* The fine level's copy goes with the solve: kept, it would sit beside
+     * the next step's matrix while that is assembled (peak memory). */
+    mf_split_csr_free(&v->fine);
+    return rc;
 }

@@ -22,9 +22,9 @@
  *
  * The fine level is the caller's matrix of this solve (rows in row space,
  * each mapped to its row of the first interpolation by its slot), copied
- * once a solve into the split layout; the coarse levels and interpolations
- * are copies of hypre's, taken right after the set-up, after which hypre's
- * objects are freed.
+ * into the split layout for the solve and freed after it; the coarse levels and interpolations
+ * are copies of hypre's, taken right after the set-up, hypre's freed as
+ * they are copied.
  */
 #ifndef MF_AMG_VCYCLE_H
 #define MF_AMG_VCYCLE_H
@@ -58,21 +58,20 @@ double mf_split_csr_matvec_dot(const mf_split_csr *A, const double *p, double *q
 typedef struct mf_amg_vcycle mf_amg_vcycle;
 
 #ifdef MF_PRESSURE_HYPRE_INTERNAL
-/* Copy the hierarchy of an AMG solver hypre has set up (one rank, at least
- * two levels, a coarsest level of at most MF_AMG_MAX_COARSEST rows). Returns
- * 0 with *out, or 0 with *out NULL when the hierarchy is not one this cycle
- * runs (the caller then uses hypre's cycle); negative on a failure. The
- * hierarchy's first interpolation has one row per unknown of the set-up's
- * matrix (a slot). */
-int mf_amg_vcycle_copy(HYPRE_Solver amg, mf_amg_vcycle **out);
+/* Take the hierarchy of an AMG solver hypre has set up (one rank, at least
+ * two levels, a coarsest level of at most MF_AMG_MAX_COARSEST rows): copy
+ * it, freeing hypre's coarse levels and interpolations as they are copied,
+ * so that amg is then good for HYPRE_BoomerAMGDestroy only (the finest
+ * level, the caller's matrix, is not read: it may be freed already).
+ * Returns 0 with *out, or 0 with *out NULL when the hierarchy is not one
+ * this cycle runs (the caller then uses hypre's cycle, set up again);
+ * negative on a failure. The hierarchy's first interpolation has one row
+ * per unknown of the set-up's matrix (a slot). */
+int mf_amg_vcycle_take(HYPRE_Solver amg, mf_amg_vcycle **out);
 #endif
 #define MF_AMG_MAX_COARSEST 2000
 
 void mf_amg_vcycle_free(mf_amg_vcycle *v);
-/* Rows of the fine level the hierarchy was set up for (slots). */
-int64_t mf_amg_vcycle_fine_rows(const mf_amg_vcycle *v);
-/* Bytes held (levels, interpolations, work vectors). */
-size_t mf_amg_vcycle_bytes(const mf_amg_vcycle *v);
 
 /* z = M r, one V-cycle with the fine matrix A0, whose row i is row
  * prow[i] of the first interpolation (NULL: row i). */
@@ -82,8 +81,8 @@ void mf_amg_vcycle_apply(mf_amg_vcycle *v, const mf_split_csr *A0, const int64_t
 /* PCG on one rank preconditioned by the V-cycle, for the matrix A of this
  * solve (one rank's CSR: columns in [0, nrows)), whose row i is row prow[i]
  * of the first interpolation (NULL: row i; prow's values distinct, inside
- * [0, mf_amg_vcycle_fine_rows)). x holds the initial guess and returns the
- * solution, r holds r0 = b - A x0 on entry (the caller has it from the
+ * [0, the first interpolation's rows)). x holds the initial guess and
+ * returns the solution, r holds r0 = b - A x0 on entry (the caller has it from the
  * initial residual) and is overwritten. The recursion's residual says when
  * to look; the true one, resid(ctx, x, r) = ||b - A x|| (also writing r,
  * from the caller's matrix), decides: 0 when it is at most tol ||b||,

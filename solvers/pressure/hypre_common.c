@@ -436,12 +436,15 @@ int mf_hypre_setup_cycle(const char *who, HYPRE_Solver amg, const mf_csr *A,
         HYPRE_Int ierr = HYPRE_BoomerAMGSetup(amg, sys.parA, sys.parb, sys.parx);
         if (ierr != 0)
             rc = mf_hypre_error(who, "HYPRE_BoomerAMGSetup", ierr, __FILE__, __LINE__, __func__);
-        else
-            rc = mf_amg_vcycle_copy(amg, cycle);
     }
-    /* The hierarchy refers to the fine matrix: destroy it first. */
-    HYPRE_BoomerAMGDestroy(amg);
+    /* The copy reads the coarse levels only: the fine matrix goes first, and
+     * the copy frees hypre's levels as it goes (peak memory: one hierarchy
+     * and a bit, not two and the matrix). amg then only needs destroying
+     * (it never frees the finest level, the caller's). */
     system_free(&sys);
+    if (rc == 0)
+        rc = mf_amg_vcycle_take(amg, cycle);
+    HYPRE_BoomerAMGDestroy(amg);
     free(zero);
     if (rc != 0)
         return mf_error_trace(rc, __FILE__, __LINE__, __func__);

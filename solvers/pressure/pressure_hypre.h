@@ -108,8 +108,8 @@ int mf_hypre_pcg_solve(const mf_hypre_pcg *pcg, const mf_csr *A, const double *b
 int mf_boomeramg_create(const mf_pcg_boomeramg_settings *s, HYPRE_Solver *out);
 
 /* One rank: assemble A as hypre's (in slot space when rows), set the AMG
- * solver amg up on it, copy the hierarchy for our V-cycle (*cycle; NULL when
- * it is not one the cycle runs), and destroy amg and hypre's matrix. */
+ * solver amg up on it, take the hierarchy for our V-cycle (*cycle; NULL when
+ * it is not one the cycle runs), and destroy hypre's matrix and amg. */
 int mf_hypre_setup_cycle(const char *who, HYPRE_Solver amg, const mf_csr *A,
                          const mf_row_names *rows, mf_amg_vcycle **cycle);
 
