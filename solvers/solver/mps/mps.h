@@ -46,6 +46,7 @@ typedef struct mps_settings {
     double shift_coefficient; /* fickian shifting: A of dr = -A l0^2 grad C */
     double shift_max;         /* largest shift a step, in l0 */
     double asymmetry;         /* asymmetry test: fraction of a flat surface's */
+    bool retry_source;        /* a retry keeps the source's density terms (mps_step.c) */
     bool collision;           /* the collision model (resolved from collision_choice) */
     double collision_distance; /* in l0 */
     bool collision_after_correction; /* a second collision pass after eqs. 15-17 */
@@ -114,6 +115,8 @@ typedef struct mps_data {
     uint8_t *flag_work; /* n: scratch (LSMPS fallbacks, the surface band) */
     size_t cap_scheme;
     double density_scale;      /* the density terms' factor this step (retries, mps_source.c) */
+    long attempt_step;         /* the step, time and dt of the first attempt at this step */
+    double attempt_time, attempt_dt;
     long shifted;              /* particles shifted in the last step */
     double shift_largest;      /* their largest shift, in l0 */
     long ls_fallbacks;         /* LSMPS rows that fell back to eq. 5/7, all steps */
@@ -160,7 +163,7 @@ typedef struct mps_data {
 enum { MPS_FLAG_SURFACE = 1 }; /* bits of the Flags field */
 
 extern const mf_solver_ops mf_solver_MPS;
-#define MPS_NPARAMS 26 /* checked against the table in mps_params.c */
+#define MPS_NPARAMS 27 /* checked against the table in mps_params.c */
 extern const mf_param mps_params[MPS_NPARAMS];
 extern const char *const mps_viscosity_choices[]; /* explicit, implicit */
 /* mps_scheme.c */
@@ -220,6 +223,9 @@ extern const char *const mps_scheme_choices[], *const mps_source_choices[],
     {"asymmetry", MF_PARAM_SCALAR, "0.2", 0, 2, NULL, OFF(asymmetry),                          \
      "surfaceDetection asymmetry: surface where n* < beta n0 and the asymmetry exceeds this "   \
      "fraction of a flat surface's"},                                                           \
+    {"retrySource", MF_PARAM_BOOL, "yes", MF_NO_RANGE, NULL, OFF(retry_source),                 \
+     "when the watch retries a step with a shorter dt, keep the density terms of the source "   \
+     "(mixed, errorCompensating) at the first attempt's strength (eq. 14 stays as printed)"},    \
     {"collision", MF_PARAM_WORD, "scheme", MF_NO_RANGE, mps_collision_choices,                 \
      OFF(collision_choice),                                                                     \
      "push apart particles closer than collisionDistance (yes/no; the paper uses none)"},      \

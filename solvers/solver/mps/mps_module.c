@@ -136,6 +136,7 @@ int mps_create_data(const mps_settings *s, mf_sim *sim, const mf_dict *solver_di
     MF_CALL(mps_scheme_resolve(s, sim->dim, &d->sc));
     d->s.collision = d->sc.collision;
     d->density_scale = 1.0;
+    d->attempt_step = -1;
     MF_CALL(mf_kernel_init(&d->k_nd, sim->dim, sim->l0, s->re_number_density * sim->l0));
     MF_CALL(mf_kernel_init(&d->k_grad, sim->dim, sim->l0, s->re_gradient * sim->l0));
     MF_CALL(mf_kernel_init(&d->k_lap, sim->dim, sim->l0, s->re_laplacian * sim->l0));

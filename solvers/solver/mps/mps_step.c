@@ -107,6 +107,26 @@ static int viscous_term(mps_data *d, mf_sim *sim)
     return 0;
 }
 
+/* A retry: the run loop (core/run/run.c) restored the particles and calls
+ * again from the same time and step with a shorter dt. The density terms of
+ * the scheme's source (mps_source.c) then keep the first attempt's
+ * strength, dt / dt_first: a density error (n - n0)/n0 corrected within one
+ * step needs a velocity of (n - n0)/n0 l / dt, which each halving would
+ * double, driving the particle-scale noise of n* harder at every retry (the
+ * 1/dt^2 of eq. 14). Eq. 14 itself (source density) is left as printed. */
+static void retry_scale(mps_data *d, const mf_sim *sim, double dt)
+{
+    if (d->s.retry_source && sim->step == d->attempt_step && sim->time == d->attempt_time &&
+        dt < d->attempt_dt) {
+        d->density_scale = dt / d->attempt_dt;
+        return;
+    }
+    d->attempt_step = sim->step;
+    d->attempt_time = sim->time;
+    d->attempt_dt = dt;
+    d->density_scale = 1.0;
+}
+
 /* eqs. 9-10: u* = u + dt (nu lap u + forces), r* = r + dt u*. With a
  * density and viscosity per particle (mps_data.mu), eq. 27: each particle's
  * own nu, pairs of unlike particles through mu_ij. */
@@ -116,6 +136,7 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
     d->attempts++;
     mf_particles *p = sim->p;
     const double nu = sim->fluid[0].nu;
+    retry_scale(d, sim, dt);
     MF_CALL(mps_source_start(d, sim)); /* what the scheme's source needs of r^n, u^n */
     memset(d->acc, 0, 3 * p->n * sizeof *d->acc);
     MF_CALL(mf_force_accumulate(sim, d->acc));
