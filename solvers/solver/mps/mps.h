@@ -172,11 +172,14 @@ extern const char *const mps_scheme_choices[], *const mps_source_choices[],
     *const mps_detection_choices[], *const mps_collision_choices[];
 /* The entries of that table, for a solver whose settings embed an
  * mps_settings (the multi-fluid solver): OFF(field) is the offset of the
- * embedded field in the embedding struct. One list, two tables.
+ * embedded field in the embedding struct; SCHEME the solver's default scheme
+ * (docs/incoming/schemes.md: MPS robust; MAFL and multiFluid paper, where
+ * robust was measured to lose MAFL points and to break the droplets'
+ * free-surface pressure). One list, three tables.
  * reNumberDensity 3.1 rather than Koshizuka & Oka's 2.1: on hydrostatic2D
  * the resting pressure comes out 7.5% high at the bottom with 2.1 and within
  * 1% with 3.1 (README, "Choices measured"). */
-#define MPS_PARAM_ENTRIES(OFF)                                                                  \
+#define MPS_PARAM_ENTRIES(OFF, SCHEME)                                                          \
     {"reNumberDensity", MF_PARAM_SCALAR, "3.1", 1.01, 10, NULL,                                 \
      OFF(re_number_density),                                                                    \
      "radius of the number density (source term, surface), in l0"},                             \
@@ -196,7 +199,7 @@ extern const char *const mps_scheme_choices[], *const mps_source_choices[],
     {"gradientPmin", MF_PARAM_BOOL, "yes", MF_NO_RANGE, NULL,                                   \
      OFF(gradient_pmin),                                                                        \
      "pressure gradient with p_min of the neighbourhood (eq. 5 note)"},                         \
-    {"scheme", MF_PARAM_WORD, "paper", MF_NO_RANGE, mps_scheme_choices, OFF(scheme),           \
+    {"scheme", MF_PARAM_WORD, SCHEME, MF_NO_RANGE, mps_scheme_choices, OFF(scheme),             \
      "the scheme: the defaults of source, gradient, laplacian, shifting, surfaceDetection "      \
      "and collision (paper: eqs. 5, 7, 14, 18 as printed)"},                                     \
     {"source", MF_PARAM_WORD, "scheme", MF_NO_RANGE, mps_source_choices, OFF(source),          \
