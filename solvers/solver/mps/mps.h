@@ -205,7 +205,7 @@ extern const char *const mps_scheme_choices[], *const mps_source_choices[],
     {"source", MF_PARAM_WORD, "scheme", MF_NO_RANGE, mps_source_choices, OFF(source),          \
      "source term of the pressure equation: density (eq. 14), mixed (Tanaka & Masunaga 2010), " \
      "higherOrder (Khayyer & Gotoh 2009), errorCompensating (Khayyer & Gotoh 2011)"},           \
-    {"densityFactor", MF_PARAM_SCALAR, "0.05", 0, 1, NULL, OFF(density_factor),                \
+    {"densityFactor", MF_PARAM_SCALAR, "0.2", 0, 1, NULL, OFF(density_factor),                \
      "source mixed: weight gamma of the density-deviation term"},                              \
     {"gradient", MF_PARAM_WORD, "scheme", MF_NO_RANGE, mps_gradient_choices, OFF(gradient),    \
      "pressure gradient: paper (eq. 5), corrected (CMPS, Khayyer & Gotoh 2008), "               \
