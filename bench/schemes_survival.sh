@@ -15,7 +15,7 @@
 #   damBreak3Dwall   the same to 0.5 s, the front hitting the far wall
 #   obstacle         bench/cases/damBreakObstacle to 0.6 s (issue: stops at 0.33 s)
 #   waterAir         tutorials/waterAirDamBreak (1000:1) at 0.02 and 0.01 m
-#   fixedDt          damBreak2D at fixed dt 1e-4 and 5e-5 to 0.6 s (issue: paper stops in 0.1 s)
+#   fixedDt          damBreak2D at fixed dt 1e-4 and 5e-5, l0 0.01, to 0.6 s (issue: paper stops in 0.1 s)
 #   tank3D           bench/cases/restingTank in 3-D at the damBreak3D settings, 1 s
 #   damBreak2D       tutorials/damBreak2D at 0.02, 0.01 and 0.005 m, front error (validate)
 # Writes bench/results/schemes_survival.csv (appends).
@@ -25,7 +25,7 @@ MPSFLOW=${MPSFLOW:-$PWD/build/driver/mpsflow}
 export OMP_NUM_THREADS=1
 out=bench/results; mkdir -p "$out"
 csv=$out/schemes_survival.csv
-[ -f "$csv" ] || echo "case,l0,variant,end,reached,steps,retries,seconds,validate,stop" > "$csv"
+[ -f "$csv" ] || echo "case,l0,variant,end,reached,steps,retries,ke_max_J,speed_max,seconds,validate,stop" > "$csv"
 work=$(mktemp -d)
 [ -n "$KEEP" ] || trap 'rm -rf "$work"' EXIT
 [ $# -gt 0 ] || set -- paper stab robust
@@ -65,13 +65,15 @@ one() {
     retries=$(grep -c 'retrying with' "$d/log")
     stop=""
     [ $rc = 0 ] || stop=$(grep -m1 -E 'unstable|through|error|Error|failed' "$d/log" | tr ',' ';' | cut -c1-140)
+    ke=$(awk '!/^#/ { if ($2 > m) m = $2; if ($3 > u) u = $3 } END { printf "%.4g,%.3g", m, u }' \
+        "$d/postProcessing/energy/kineticEnergy.dat" 2>/dev/null)
     val=""
     if [ $rc = 0 ] && [ -d "$d/validation" ]; then
-        val=$("$MPSFLOW" validate -case "$d" 2>&1 | awk '/^Error/ { print $NF }' | head -1)
+        val=$("$MPSFLOW" validate -case "$d" 2>&1 | awk '/^[Ee]rror / { print $NF }' | head -1)
     fi
-    printf "%-15s l0 %-8s %-12s end %-5s reached %-8s steps %6s retries %3s %6s s  validate %-9s %s\n" \
-        "$name" "$l0" "$vname" "$end" "$reached" "$steps" "$retries" "$secs" "$val" "$stop"
-    echo "$name,$l0,$vname,$end,$reached,$steps,$retries,$secs,$val,$stop" >> "$csv"
+    printf "%-15s l0 %-8s %-12s end %-5s reached %-8s steps %6s retries %3s KE max, speed max %-14s %6s s  validate %-9s %s\n" \
+        "$name" "$l0" "$vname" "$end" "$reached" "$steps" "$retries" "$ke" "$secs" "$val" "$stop"
+    echo "$name,$l0,$vname,$end,$reached,$steps,$retries,$ke,$secs,$val,$stop" >> "$csv"
 }
 
 # The 3-D resting tank at the damBreak3D settings (l0 0.025 m, radii 3.1,
