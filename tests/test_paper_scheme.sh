@@ -3,7 +3,8 @@
 # case of tests/paper_scheme/ runs with `scheme paper;` added to its
 # solver's Coeffs, and its last snapshot's particle groups are compared by
 # h5diff (exact: no tolerance) with tests/paper_scheme/reference/<case>.h5,
-# written by main at 30c2725 (before the schemes) from the same case files:
+# written from the same case files by main before the schemes merged, at
+# 34602fe (speed's own PCG: rounding differs from 30c2725's hypre PCG):
 #   MPS relaxation 0.2 + collision + collisionAfterCorrection (damBreak2D),
 #   MPS plain (hydrostatic2D: relaxation 1, no collision),
 #   MPS implicit viscosity on a periodic channel (poiseuille2D),
