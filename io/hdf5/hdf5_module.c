@@ -13,6 +13,7 @@
 
 #include "hdf5_internal.h"
 #include "mf_error.h"
+#include "mf_fs.h"
 #include "mf_hdf5.h"
 
 typedef struct hdf5_settings {
@@ -33,18 +34,6 @@ typedef struct hdf5_writer {
     int *written;         /* indices this writer wrote, oldest first (purgeWrite) */
     size_t nwritten, capwritten;
 } hdf5_writer;
-
-static int make_output_dir(const char *dir)
-{
-    if (mkdir(dir, 0777) == 0)
-        return 0;
-    if (errno != EEXIST)
-        return MF_ERROR(MF_ERR_IO, "cannot create %s: %s", dir, strerror(errno));
-    struct stat st;
-    if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode))
-        return MF_ERROR(MF_ERR_IO, "%s exists but is not a folder", dir);
-    return 0;
-}
 
 static int hdf5_create(const void *settings, const char *case_dir, void **data)
 {
@@ -69,7 +58,7 @@ static int hdf5_create(const void *settings, const char *case_dir, void **data)
     }
     memcpy(w->case_dir, case_dir, strlen(case_dir) + 1);
     MF_CALL_GOTO(rc, mf_h5_output_dir(case_dir, w->output_dir, sizeof w->output_dir), fail);
-    MF_CALL_GOTO(rc, make_output_dir(w->output_dir), fail);
+    MF_CALL_GOTO(rc, mf_mkdir(w->output_dir), fail);
 
     int *indices;
     size_t n;

@@ -15,6 +15,7 @@
 #include <sys/stat.h>
 
 #include "mf_error.h"
+#include "mf_fs.h"
 #include "mf_mesh_writer.h"
 #include "mf_timetext.h"
 
@@ -52,22 +53,6 @@ static float get_f32le(const uint8_t *p)
     float f;
     memcpy(&f, &v, 4);
     return f;
-}
-
-static int make_dirs(const char *path)
-{
-    char buf[PATH_MAX_LEN];
-    snprintf(buf, sizeof buf, "%s", path);
-    for (char *s = buf + 1; *s; s++)
-        if (*s == '/') {
-            *s = '\0';
-            if (mkdir(buf, 0777) != 0 && errno != EEXIST)
-                return MF_ERROR(MF_ERR_IO, "%s: cannot create (%s)", buf, strerror(errno));
-            *s = '/';
-        }
-    if (mkdir(buf, 0777) != 0 && errno != EEXIST)
-        return MF_ERROR(MF_ERR_IO, "%s: cannot create (%s)", buf, strerror(errno));
-    return 0;
 }
 
 /* Finish a file written under "<path>.tmp": close, check, rename. */
@@ -473,7 +458,7 @@ int mf_mesh_write_xdmf_index(const char *dir, const char *prefix)
 int mf_mesh_write_frame(const char *dir, const char *prefix, int index, const mf_mesh *m,
                         bool ply, bool obj)
 {
-    MF_CALL(make_dirs(dir));
+    MF_CALL(mf_mkdir_p(dir));
     char path[PATH_MAX_LEN];
     if (ply) {
         snprintf(path, sizeof path, "%s/%s_%06d.ply", dir, prefix, index);
