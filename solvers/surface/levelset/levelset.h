@@ -38,6 +38,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "mf_clock.h"
 #include "mf_log.h"
 #include "mf_mesh.h"
 #include "mf_modules.h"
@@ -370,10 +371,6 @@ int ls_frame(ls_data *d, const mf_sim *sim, mf_mesh *out);
 
 /* ---- helpers ------------------------------------------------------------- */
 
-double ls_seconds(void);
-/* CPU time of the process, all threads (the machine may be shared: wall
- * time alone does not say what a frame costs). */
-double ls_cpu_seconds(void);
 /* The grid spacing a setting gives (0: l0 / 2). */
 static inline double ls_grid_spacing(double setting, double l0)
 {
