@@ -2,6 +2,7 @@
  * pattern, the particles a set of matrix rows stands for). */
 #ifndef MF_HASH_H
 #define MF_HASH_H
+#pragma GCC visibility push(default) /* the plugin API (an installed header) */
 
 #include <stdint.h>
 
@@ -19,4 +20,5 @@ static inline uint64_t mf_hash_word(uint64_t h, uint64_t v)
     return (h ^ v) * 0x100000001b3ull;
 }
 
+#pragma GCC visibility pop
 #endif

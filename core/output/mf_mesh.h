@@ -11,6 +11,7 @@
  * The functions are static inline so that core needs no new object file. */
 #ifndef MF_MESH_H
 #define MF_MESH_H
+#pragma GCC visibility push(default) /* the plugin API (an installed header) */
 
 #include <stdint.h>
 #include <stdlib.h>
@@ -75,4 +76,5 @@ static inline size_t mf_mesh_memory(const mf_mesh *m)
     return m->cap_verts * 6 * sizeof(float) + m->cap_tris * 3 * sizeof(int32_t);
 }
 
+#pragma GCC visibility pop
 #endif

@@ -27,6 +27,7 @@
  */
 #ifndef MF_NEIGHBOURS_H
 #define MF_NEIGHBOURS_H
+#pragma GCC visibility push(default) /* the plugin API (an installed header) */
 
 #include <stdbool.h>
 #include <stddef.h>
@@ -174,4 +175,5 @@ typedef struct mf_neighbours_stats {
 } mf_neighbours_stats;
 void mf_neighbours_get_stats(const mf_neighbours *nb, mf_neighbours_stats *out);
 
+#pragma GCC visibility pop
 #endif
