@@ -28,6 +28,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_alloc.h"
 #include "mf_clock.h"
 #include "mf_error.h"
 #include "mf_pairs.h"
@@ -135,10 +136,8 @@ static int class_of(mf_neighbours *nb, double cell, int *out)
         }
     if (nb->nclasses == nb->cap_classes) {
         int cap = 2 * nb->cap_classes + 4;
-        nb_class *grown = realloc(nb->cls, (size_t)cap * sizeof *grown);
-        if (!grown)
+        if (mf_resize(&nb->cls, (size_t)cap, sizeof *nb->cls))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for neighbour lists");
-        nb->cls = grown;
         nb->cap_classes = cap;
     }
     nb_class *c = &nb->cls[nb->nclasses];
@@ -174,10 +173,8 @@ int mf_neighbours_request(mf_neighbours *nb, double radius, double cell, int *ha
                         radius, cell);
     if (nb->nhandles == nb->cap_handles) {
         int cap = 2 * nb->cap_handles + 8;
-        nb_handle *grown = realloc(nb->handle, (size_t)cap * sizeof *grown);
-        if (!grown)
+        if (mf_resize(&nb->handle, (size_t)cap, sizeof *nb->handle))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for neighbour requests");
-        nb->handle = grown;
         nb->cap_handles = cap;
     }
     nb_handle *h = &nb->handle[nb->nhandles];
@@ -265,10 +262,8 @@ static int build(mf_neighbours *nb, nb_class *c, const mf_particles *p)
     const size_t np = p->n;
     if (np > c->cap_id) {
         size_t cap = np + np / 8 + 16;
-        int64_t *grown = realloc(c->id0, cap * sizeof *grown);
-        if (!grown)
+        if (mf_resize(&c->id0, cap, sizeof *c->id0))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu particle ids", np);
-        c->id0 = grown;
         c->cap_id = cap;
     }
     for (size_t k = 0; k < np; k++)

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_alloc.h"
 #include "mf_error.h"
 #include "mf_params.h"
 #include "mf_scene.h"
@@ -717,10 +718,8 @@ static int grow_flags(mf_emitters *em, size_t n)
     if (n <= em->cap_flag)
         return 0;
     size_t cap = n + n / 4 + 64;
-    unsigned char *f = realloc(em->flag, cap);
-    if (!f)
+    if (mf_resize(&em->flag, cap, 1))
         return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu particle flags", n);
-    em->flag = f;
     em->cap_flag = cap;
     return 0;
 }

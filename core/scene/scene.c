@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_alloc.h"
 #include "mf_emitter.h"
 #include "mf_error.h"
 #include "mf_params.h"
@@ -332,10 +333,8 @@ static int parse_open_faces(const mf_dict *d, const char *name, bool open[3][2])
 
 static int record_wall_box(mf_sim *sim, const double *mn, const double *mx, bool open[3][2])
 {
-    mf_wall_box *grown = realloc(sim->wall_boxes, (sim->nwall_boxes + 1) * sizeof *grown);
-    if (!grown)
+    if (mf_resize(&sim->wall_boxes, sim->nwall_boxes + 1, sizeof *sim->wall_boxes))
         return MF_ERROR(MF_ERR_MEMORY, "out of memory");
-    sim->wall_boxes = grown;
     mf_wall_box *b = &sim->wall_boxes[sim->nwall_boxes++];
     memcpy(b->min, mn, sizeof b->min);
     memcpy(b->max, mx, sizeof b->max);

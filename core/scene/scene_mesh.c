@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_alloc.h"
 #include "mf_emitter.h"
 #include "mf_error.h"
 #include "mf_params.h"
@@ -216,13 +217,8 @@ static int band_push(band *b, uint64_t key, double d2, int side)
     }
     if (b->n == b->cap) {
         size_t cap = b->cap ? 2 * b->cap : 1024;
-        uint64_t *k = realloc(b->key, cap * sizeof *k);
-        if (k) b->key = k;
-        double *d = realloc(b->d2, cap * sizeof *d);
-        if (d) b->d2 = d;
-        int8_t *s = realloc(b->side, cap * sizeof *s);
-        if (s) b->side = s;
-        if (!k || !d || !s)
+        if (mf_resize(&b->key, cap, sizeof *b->key) || mf_resize(&b->d2, cap, sizeof *b->d2) ||
+            mf_resize(&b->side, cap, sizeof *b->side))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu lattice points near a surface",
                             cap);
         b->cap = cap;
@@ -946,13 +942,11 @@ static int fill_points(const mesh_item *it, const lattice *L, int out_sign, cons
                     continue;
                 if (ncr == capcr) {
                     size_t cap = capcr ? 2 * capcr : 1024;
-                    crossing *g = realloc(cr, cap * sizeof *g);
-                    if (!g) {
+                    if (mf_resize(&cr, cap, sizeof *cr)) {
                         free(cr);
                         return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu ray crossings",
                                         cap);
                     }
-                    cr = g;
                     capcr = cap;
                 }
                 double at = (w[0] * v[0][ax] + w[1] * v[1][ax] + w[2] * v[2][ax]) / area2;
@@ -988,14 +982,12 @@ static int fill_points(const mesh_item *it, const lattice *L, int out_sign, cons
                     continue; /* on the surface or outside by the walls' own reckoning */
                 if (nkeys == capk) {
                     size_t cap = capk ? 2 * capk : 4096;
-                    uint64_t *g = realloc(keys, cap * sizeof *g);
-                    if (!g) {
+                    if (mf_resize(&keys, cap, sizeof *keys)) {
                         free(keys);
                         free(cr);
                         return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu fluid points",
                                         cap);
                     }
-                    keys = g;
                     capk = cap;
                 }
                 keys[nkeys++] = key;

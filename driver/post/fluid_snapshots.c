@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_alloc.h"
 #include "mf_dictio.h"
 #include "mf_error.h"
 #include "mf_post.h"
@@ -82,12 +83,8 @@ int mf_table_add(mf_table *t, const double *row)
 {
     if (t->n == t->cap) {
         size_t cap = t->cap ? 2 * t->cap : 64;
-        for (size_t c = 0; c < t->ncols; c++) {
-            double *g = realloc(t->col[c], cap * sizeof *g);
-            if (!g)
-                return MF_ERROR(MF_ERR_MEMORY, "out of memory");
-            t->col[c] = g;
-        }
+        for (size_t c = 0; c < t->ncols; c++)
+            MF_CALL(mf_resize(&t->col[c], cap, sizeof *t->col[c]));
         t->cap = cap;
     }
     for (size_t c = 0; c < t->ncols; c++)

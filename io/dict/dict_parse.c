@@ -23,6 +23,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "mf_alloc.h"
 #include "mf_error.h"
 
 /* ------------------------------------------------------------------------
@@ -341,12 +342,10 @@ static int vec_push(vec *v, mf_value *x)
 {
     if (v->n == v->cap) {
         size_t cap = v->cap ? 2 * v->cap : 1; /* most entries hold one item */
-        mf_value **grown = realloc(v->items, cap * sizeof *grown);
-        if (!grown) {
+        if (mf_resize(&v->items, cap, sizeof *v->items)) {
             mf_value_free(x);
             return MF_ERR_MEMORY;
         }
-        v->items = grown;
         v->cap = cap;
     }
     v->items[v->n++] = x;

@@ -11,6 +11,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "mf_alloc.h"
 #include "hdf5_internal.h"
 #include "mf_error.h"
 #include "mf_fs.h"
@@ -85,10 +86,8 @@ static int hdf5_write(void *data, const mf_sim *sim, const mf_dict *params)
     int index = w->next_index++;
     if (w->nwritten == w->capwritten) {
         size_t cap = w->capwritten ? 2 * w->capwritten : 64;
-        int *grown = realloc(w->written, cap * sizeof *grown);
-        if (!grown)
+        if (mf_resize(&w->written, cap, sizeof *w->written))
             return MF_ERROR(MF_ERR_MEMORY, "hdf5 writer: out of memory");
-        w->written = grown;
         w->capwritten = cap;
     }
     w->written[w->nwritten++] = index;

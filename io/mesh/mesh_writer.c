@@ -14,6 +14,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "mf_alloc.h"
 #include "mf_error.h"
 #include "mf_fs.h"
 #include "mf_mesh_writer.h"
@@ -356,12 +357,10 @@ static int scan_frames(const char *dir, const char *prefix, frame **out, size_t 
             continue;
         if (*n == cap) {
             cap = cap ? 2 * cap : 64;
-            frame *g = realloc(*out, cap * sizeof *g);
-            if (!g) {
+            if (mf_resize(out, cap, sizeof **out)) {
                 rc = MF_ERROR(MF_ERR_MEMORY, "out of memory listing %s", dir);
                 break;
             }
-            *out = g;
         }
         (*out)[*n].index = idx;
         (*n)++;

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "surface_tension.h"
+#include "mf_alloc.h"
 #include "mf_error.h"
 
 static void st_destroy(void *data)
@@ -85,34 +86,14 @@ int st_reserve(st_data *d, size_t n)
     if (n <= d->cap)
         return 0;
     size_t cap = n + n / 4 + 64;
-    int32_t *n1 = realloc(d->n1, cap * sizeof *n1);
-    if (n1)
-        d->n1 = n1;
-    int32_t *nall = realloc(d->nall, cap * sizeof *nall);
-    if (nall)
-        d->nall = nall;
-    double *k = realloc(d->kappa, cap * sizeof *k);
-    if (k)
-        d->kappa = k;
-    double *ks = realloc(d->kappa_s, cap * sizeof *ks);
-    if (ks)
-        d->kappa_s = ks;
-    double *f = realloc(d->fdir, 3 * cap * sizeof *f);
-    if (f)
-        d->fdir = f;
-    double *nr = realloc(d->nrm, 3 * cap * sizeof *nr);
-    if (nr)
-        d->nrm = nr;
-    double *ps = realloc(d->p_surface, cap * sizeof *ps);
-    if (ps)
-        d->p_surface = ps;
-    double *ko = realloc(d->kappa_out, cap * sizeof *ko);
-    if (ko)
-        d->kappa_out = ko;
-    double *ao = realloc(d->accel_out, 3 * cap * sizeof *ao);
-    if (ao)
-        d->accel_out = ao;
-    if (!n1 || !nall || !k || !ks || !f || !nr || !ps || !ko || !ao)
+    if (mf_resize(&d->n1, cap, sizeof *d->n1) || mf_resize(&d->nall, cap, sizeof *d->nall) ||
+        mf_resize(&d->kappa, cap, sizeof *d->kappa) ||
+        mf_resize(&d->kappa_s, cap, sizeof *d->kappa_s) ||
+        mf_resize(&d->fdir, 3 * cap, sizeof *d->fdir) ||
+        mf_resize(&d->nrm, 3 * cap, sizeof *d->nrm) ||
+        mf_resize(&d->p_surface, cap, sizeof *d->p_surface) ||
+        mf_resize(&d->kappa_out, cap, sizeof *d->kappa_out) ||
+        mf_resize(&d->accel_out, 3 * cap, sizeof *d->accel_out))
         return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu particles", n);
     d->cap = cap;
     return 0;

@@ -8,6 +8,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "mf_alloc.h"
 #include "levelset.h"
 
 size_t ls_memory_limit(double max_memory_mb)
@@ -119,10 +120,8 @@ int ls_bricks_insert(ls_bricks *b, int32_t bx, int32_t by, int32_t bz, int32_t *
         MF_CALL(rehash(b, b->hcap ? 2 * b->hcap : 1024));
     if (b->n == b->cap) {
         size_t cap = b->cap ? 2 * b->cap : 256;
-        int32_t *coord = realloc(b->coord, 3 * cap * sizeof *coord);
-        if (!coord)
+        if (mf_resize(&b->coord, 3 * cap, sizeof *b->coord))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu bricks", cap);
-        b->coord = coord;
         b->cap = cap;
     }
     int32_t k = (int32_t)b->n++;
