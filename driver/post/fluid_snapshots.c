@@ -10,38 +10,37 @@
 #include "mf_post.h"
 #include "mf_scene.h"
 
-/* Index of a fluid of the case by name (constant/fluids order). */
-int mf_post_fluid_index(const char *case_dir, const char *name, int *index)
+/* The case's constant/fluids into sim's fluid table. */
+static int read_fluids(const char *case_dir, mf_sim *sim)
 {
     char path[4200];
     snprintf(path, sizeof path, "%s/constant/fluids", case_dir);
     mf_dict *d = NULL;
     MF_CALL(mf_dict_parse_file(path, &d));
+    memset(sim, 0, sizeof *sim);
+    int rc = mf_scene_read_fluids(d, sim);
+    mf_dict_free(d);
+    return rc;
+}
+
+int mf_post_fluid_index(const char *case_dir, const char *name, int *index)
+{
     mf_sim sim;
-    memset(&sim, 0, sizeof sim);
-    int rc = mf_scene_read_fluids(d, &sim);
+    int rc = read_fluids(case_dir, &sim);
     if (rc == 0)
         rc = mf_scene_fluid_index(&sim, name, index);
-    mf_dict_free(d);
     if (rc != 0)
         return MF_ERROR(rc, "%s/validation/metric: %s", case_dir, mf_error_message());
     return 0;
 }
 
-/* The densities of the case's fluids (constant/fluids order). */
 int mf_post_fluid_densities(const char *case_dir, double rho[MF_MAX_FLUIDS])
 {
-    char path[4200];
-    snprintf(path, sizeof path, "%s/constant/fluids", case_dir);
-    mf_dict *d = NULL;
-    MF_CALL(mf_dict_parse_file(path, &d));
     mf_sim sim;
-    memset(&sim, 0, sizeof sim);
-    int rc = mf_scene_read_fluids(d, &sim);
-    for (int k = 0; rc == 0 && k < sim.nfluids; k++)
+    MF_CALL(read_fluids(case_dir, &sim));
+    for (int k = 0; k < sim.nfluids; k++)
         rho[k] = sim.fluid[k].rho;
-    mf_dict_free(d);
-    return rc;
+    return 0;
 }
 
 int mf_fsnap_load(const char *case_dir, int index, mf_fsnap *s)
