@@ -45,11 +45,18 @@ static inline size_t mf_hashmap_find(const mf_hashmap *m, uint64_t key)
     return SIZE_MAX;
 }
 
-/* The value of key, or MF_HASHMAP_EMPTY. */
+/* The value of key, or MF_HASHMAP_EMPTY. One load of the slot's value per
+ * probe (the neighbour grid's lookup: no slot index to return). */
 static inline uint32_t mf_hashmap_get(const mf_hashmap *m, uint64_t key)
 {
-    size_t s = mf_hashmap_find(m, key);
-    return s == SIZE_MAX ? MF_HASHMAP_EMPTY : m->val[s];
+    if (!m->cap)
+        return MF_HASHMAP_EMPTY;
+    const size_t mask = m->cap - 1;
+    for (size_t s = (size_t)mf_hash_mix64(key) & mask;; s = (s + 1) & mask) {
+        const uint32_t v = m->val[s];
+        if (v == MF_HASHMAP_EMPTY || m->key[s] == key)
+            return v;
+    }
 }
 
 /* Store key -> val in the first free slot of key's probe sequence and return
