@@ -8,7 +8,8 @@ default, so the executable's dynamic symbol table holds what they declare
 and nothing else of ours. Besides those, it holds what the C runtime and
 the linker put there (_start, _edata, ...) and data of shared libraries
 copied into the executable (stdout, ompi_mpi_comm_world: R_*_COPY
-relocations). Every other exported symbol must start with mf_ (or MF_).
+relocations), and AddressSanitizer's __odr_asan.<name> beside an exported
+global. Every other exported symbol must start with mf_ (or MF_).
 
 Usage: check_exports.py EXECUTABLE [PLUGIN.so ...]
 Each plugin's undefined mf_ symbols must be exported by the executable.
@@ -47,8 +48,10 @@ def copied(path):
 def main(argv):
     exe = argv[1]
     exported = dynamic_symbols(exe, "--defined-only")
+    # AddressSanitizer adds an __odr_asan.<name> indicator beside each exported
+    # global: it stands for <name>.
     bad = sorted(s for s in exported - RUNTIME - copied(exe)
-                 if not re.match(r"(mf|MF)_", s))
+                 if not re.match(r"(__odr_asan\.)?(mf|MF)_", s))
     api = sorted(s for s in exported if re.match(r"(mf|MF)_", s))
     status = 0
     if bad:
