@@ -8,8 +8,8 @@ default, so the executable's dynamic symbol table holds what they declare
 and nothing else of ours. Besides those, it holds what the C runtime and
 the linker put there (_start, _edata, ...) and data of shared libraries
 copied into the executable (stdout, ompi_mpi_comm_world: R_*_COPY
-relocations), and AddressSanitizer's __odr_asan.<name> beside an exported
-global. Every other exported symbol must start with mf_ (or MF_).
+relocations), AddressSanitizer's __odr_asan.<name> beside an exported
+global, and the locks of OpenMP critical sections (.gomp_critical_user_*). Every other exported symbol must start with mf_ (or MF_).
 
 Usage: check_exports.py EXECUTABLE [PLUGIN.so ...]
 Each plugin's undefined mf_ symbols must be exported by the executable.
@@ -21,6 +21,10 @@ import sys
 RUNTIME = {"_start", "_init", "_fini", "_edata", "_end", "__bss_start", "__data_start",
            "data_start", "_IO_stdin_used", "__dso_handle", "__libc_csu_init",
            "__libc_csu_fini"}
+
+# The lock of an OpenMP named critical section (clang names the one of its
+# reductions so): the compiler makes it a common symbol, shared by design.
+GOMP_LOCK = ".gomp_critical_user_"
 
 
 def dynamic_symbols(path, flag):
@@ -51,7 +55,7 @@ def main(argv):
     # AddressSanitizer adds an __odr_asan.<name> indicator beside each exported
     # global: it stands for <name>.
     bad = sorted(s for s in exported - RUNTIME - copied(exe)
-                 if not re.match(r"(__odr_asan\.)?(mf|MF)_", s))
+                 if not re.match(r"(__odr_asan\.)?(mf|MF)_", s) and not s.startswith(GOMP_LOCK))
     api = sorted(s for s in exported if re.match(r"(mf|MF)_", s))
     status = 0
     if bad:
