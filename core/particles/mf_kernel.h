@@ -6,6 +6,7 @@
  * are the same bit for bit whichever loop runs them. */
 #ifndef MF_KERNEL_H
 #define MF_KERNEL_H
+#pragma GCC visibility push(default) /* the plugin API (an installed header) */
 
 #include <math.h>
 
@@ -105,4 +106,5 @@ typedef struct mf_kernel {
  * 3-D cubic) of spacing l0, every lattice point within re of the origin. */
 int mf_kernel_init(mf_kernel *k, int dim, double l0, double re);
 
+#pragma GCC visibility pop
 #endif

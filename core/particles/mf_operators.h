@@ -11,6 +11,7 @@
  */
 #ifndef MF_OPERATORS_H
 #define MF_OPERATORS_H
+#pragma GCC visibility push(default) /* the plugin API (an installed header) */
 
 #include <stdbool.h>
 #include <stdint.h>
@@ -115,4 +116,5 @@ void mf_collision(const mf_pairs *v, const uint8_t *movable, const double *rho, 
 /* eq. 18: flag[i] = 1 where n[i] < beta n0 (free surface), else 0. */
 void mf_free_surface(const double *n, size_t count, double beta, double n0, uint8_t *flag);
 
+#pragma GCC visibility pop
 #endif

@@ -2,6 +2,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_alloc.h"
 #include "mf_error.h"
 #include "mps.h"
 
@@ -109,15 +110,11 @@ int mps_reserve(mps_data *d, size_t n)
     if (n <= d->cap)
         return 0;
     size_t cap = n + n / 4 + 64;
-    d->acc = realloc(d->acc, 3 * cap * sizeof *d->acc);
-    d->grad = realloc(d->grad, 3 * cap * sizeof *d->grad);
-    d->is_fluid = realloc(d->is_fluid, cap);
-    d->in_ppe = realloc(d->in_ppe, cap);
-    d->dirichlet = realloc(d->dirichlet, cap);
-    d->not_dummy = realloc(d->not_dummy, cap);
-    d->row = realloc(d->row, cap * sizeof *d->row);
-    if (!d->acc || !d->grad || !d->is_fluid || !d->in_ppe || !d->dirichlet || !d->not_dummy ||
-        !d->row)
+    if (mf_resize(&d->acc, 3 * cap, sizeof *d->acc) ||
+        mf_resize(&d->grad, 3 * cap, sizeof *d->grad) ||
+        mf_resize(&d->is_fluid, cap, 1) || mf_resize(&d->in_ppe, cap, 1) ||
+        mf_resize(&d->dirichlet, cap, 1) || mf_resize(&d->not_dummy, cap, 1) ||
+        mf_resize(&d->row, cap, sizeof *d->row))
         return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu particles", n);
     d->cap = cap;
     return 0;

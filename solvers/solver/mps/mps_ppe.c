@@ -23,20 +23,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_alloc.h"
 #include "mf_error.h"
 #include "mf_hash.h"
 #include "mf_run.h"
 #include "mps.h"
-
-/* Grow *ptr to count elements, keeping the old block when that fails. */
-static int grow(void **ptr, size_t count, size_t elem)
-{
-    void *grown = realloc(*ptr, count * elem);
-    if (!grown)
-        return MF_ERR_MEMORY;
-    *ptr = grown;
-    return 0;
-}
 
 /* Room for rows unknowns and nnz entries; 1/16 headroom (the counts drift
  * little from step to step, and the matrix is the largest array of a run). */
@@ -44,15 +35,15 @@ static int reserve_system(mps_data *d, size_t rows, size_t nnz)
 {
     if (rows + 1 > d->cap_rows) {
         size_t cap = rows + rows / 16 + 64;
-        if (grow((void **)&d->A.rowptr, cap + 1, sizeof *d->A.rowptr) ||
-            grow((void **)&d->rhs, cap, sizeof *d->rhs) || grow((void **)&d->x, cap, sizeof *d->x))
+        if (mf_resize(&d->A.rowptr, cap + 1, sizeof *d->A.rowptr) ||
+            mf_resize(&d->rhs, cap, sizeof *d->rhs) || mf_resize(&d->x, cap, sizeof *d->x))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu pressure unknowns", rows);
         d->cap_rows = cap;
     }
     if (nnz > d->cap_nnz) {
         size_t cap = nnz + nnz / 16 + 64;
-        if (grow((void **)&d->A.col, cap, sizeof *d->A.col) ||
-            grow((void **)&d->A.val, cap, sizeof *d->A.val))
+        if (mf_resize(&d->A.col, cap, sizeof *d->A.col) ||
+            mf_resize(&d->A.val, cap, sizeof *d->A.val))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu matrix entries", nnz);
         d->cap_nnz = cap;
     }
@@ -339,10 +330,8 @@ static int name_rows(mps_data *d, const mf_sim *sim, mf_row_names *rows)
     const mf_particles *p = sim->p;
     if (d->A.nrows > d->cap_slot) {
         size_t cap = d->A.nrows + d->A.nrows / 4 + 64;
-        int64_t *grown = realloc(d->slot, cap * sizeof *grown);
-        if (!grown)
+        if (mf_resize(&d->slot, cap, sizeof *d->slot))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu pressure unknowns", cap);
-        d->slot = grown;
         d->cap_slot = cap;
     }
     uint64_t h = mf_hash_word(MF_HASH_START, p->n_owned);
