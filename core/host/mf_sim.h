@@ -12,6 +12,7 @@
 #include "mf_dict.h"
 #include "mf_log.h"
 #include "mf_neighbours.h"
+#include "mf_parallel.h"
 #include "mf_particles.h"
 #include "mf_registry.h"
 
@@ -77,6 +78,8 @@ typedef struct mf_sim {
     bool viscosity_implicit;
     const mf_registry *reg;
     mf_log *log;
+    /* The ranks of a -parallel run (mf_parallel.h); NULL for a serial run. */
+    mf_parallel *par;
     /* Statistics the driver reports (filled by modules). */
     double courant_mean, courant_max;
     long pressure_iterations;  /* summed over the run */

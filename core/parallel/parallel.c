@@ -1,5 +1,6 @@
 /* parallel.c: the communicator, reductions and agreement of mf_parallel.h. */
 #include "parallel_internal.h"
+#include "mf_parallel_mpi.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -213,4 +214,9 @@ void mf_parallel_abort(const mf_parallel *par, int rc)
     fprintf(stderr, "mpsflow: MPI rank %d stops every rank:\n", par->rank);
     mf_error_print(stderr);
     MPI_Abort(par->comm, rc < 0 ? -rc : 1);
+}
+
+MPI_Comm mf_parallel_comm(const mf_parallel *par)
+{
+    return par ? par->comm : MPI_COMM_SELF;
 }

@@ -2,6 +2,7 @@
  *
  *   mpsflow [-case DIR] [-solver NAME] [-libs '(...)'] [-dryRun] [-latestTime]
  *   mpsflow modules [NAME]
+ *   mpirun -np N mpsflow -parallel -case DIR     (one case on N ranks)
  */
 #include <limits.h>
 #include <mpi.h>
@@ -37,6 +38,8 @@ static void usage(FILE *f)
             "  -dryRun           read the case, build the scene, print a summary, stop\n"
             "  -latestTime       restart from the newest snapshot in DIR/output\n"
             "  -l0 VALUE         particle spacing, overriding constant/geometry (coarse/fine)\n"
+            "  -parallel         run one case on the ranks of mpirun -np N (decomposition:\n"
+            "                    system/decomposeParDict, optional)\n"
             "  -endTime VALUE    end time, overriding system/controlDict\n"
             "  -solvers '(...)'  compare: schemes (variants of system/compareDict, or solvers)\n"
             "  -resolutions '(...)'  compare: particle spacings\n"
@@ -64,7 +67,7 @@ static int parse_options(int argc, char **argv, int first, mf_options *opt)
 {
     static const char *const known[] = {"-case", "-solver", "-libs", "-dryRun", "-latestTime",
                                         "-l0", "-endTime", "-quiet", "-verbose", "-help",
-                                        "-solvers", "-resolutions", "-sweeps"};
+                                        "-solvers", "-resolutions", "-sweeps", "-parallel"};
     for (int i = first; i < argc; i++) {
         const char *a = argv[i];
         bool has_value = i + 1 < argc;
@@ -74,6 +77,8 @@ static int parse_options(int argc, char **argv, int first, mf_options *opt)
             opt->dry_run = true;
         else if (!strcmp(a, "-latestTime"))
             opt->latest_time = true;
+        else if (!strcmp(a, "-parallel"))
+            opt->parallel = true;
         else if (!strcmp(a, "-quiet"))
             opt->log_level = MF_LOG_QUIET;
         else if (!strcmp(a, "-verbose"))
@@ -156,14 +161,9 @@ int mf_cmd_modules(mf_registry *reg, const char *name)
     return 0;
 }
 
-int mf_cmd_run(mf_app *app)
+/* The run itself; every rank of a -parallel run calls it. */
+static int run_case(mf_app *app)
 {
-    MF_CALL(mf_app_setup(app));
-    if (app->opt.dry_run) {
-        mf_app_summary(app);
-        printf("\nDry run: stopping before the time loop.\nEnd\n");
-        return 0;
-    }
     bool restart = app->opt.latest_time || !strcmp(app->cs.control.start_from, "latestTime");
     if (restart) {
         const mf_writer_ops *w = (const mf_writer_ops *)app->writer.info;
@@ -173,12 +173,15 @@ int mf_cmd_run(mf_app *app)
         mf_log_printf(&app->log, MF_LOG_NORMAL, "Restarting from time %g (step %ld)\n",
                       app->sim.time, app->sim.step);
     }
-    MF_CALL(mf_case_write_resolved(&app->cs));
+    MF_CALL(mf_parallel_agree(app->sim.par, mf_app_distribute(app)));
+    if (mf_parallel_is_root(app->sim.par))
+        MF_CALL(mf_case_write_resolved(&app->cs));
     mf_app_summary(app);
     int rc = mf_run_loop(&app->run, !restart);
     const mf_solver_ops *ops = (const mf_solver_ops *)app->solver.info;
     if (ops->report)
         ops->report(app->solver.data, &app->sim, &app->log);
+    mf_app_report_parallel(app);
     mf_log_printf(&app->log, MF_LOG_QUIET,
                   "\nSteps %ld (retried %ld), snapshots %d, wall time %.2f s, peak memory %.1f "
                   "MB\n",
@@ -189,6 +192,28 @@ int mf_cmd_run(mf_app *app)
     MF_CALL(rc);
     mf_log_printf(&app->log, MF_LOG_QUIET, "End\n");
     return 0;
+}
+
+int mf_cmd_run(mf_app *app)
+{
+    int rc = mf_app_setup(app);
+    /* Reading the case and building the scene is the same on every rank,
+     * but a rank may still fail alone (memory): agree before the first
+     * collective step. */
+    rc = mf_parallel_agree(app->sim.par, rc);
+    if (rc == 0 && app->opt.dry_run) {
+        MF_CALL(mf_parallel_agree(app->sim.par, mf_app_distribute(app)));
+        mf_app_summary(app);
+        if (mf_parallel_is_root(app->sim.par))
+            printf("\nDry run: stopping before the time loop.\nEnd\n");
+        return 0;
+    }
+    if (rc == 0)
+        rc = run_case(app);
+    /* The time loop agrees on every step's status; this covers the rest. */
+    rc = mf_parallel_agree(app->sim.par, rc);
+    app->error_agreed = app->sim.par != NULL;
+    return rc;
 }
 
 int main(int argc, char **argv)
@@ -233,7 +258,24 @@ int main(int argc, char **argv)
     }
     MPI_Init(&argc, &argv);
     HYPRE_Init();
-    rc = mf_registry_create(&app.reg);
+    const bool root = mf_parallel_world_rank() == 0;
+    rc = mf_app_check_parallel(&app.opt, argc, argv);
+    if (rc == 0 && command && mf_parallel_world_size() > 1 &&
+        (!strcmp(command, "compare") || !strcmp(command, "stability")))
+        rc = MF_ERROR(MF_ERR_INPUT,
+                      "%s runs the case many times as child processes and compares their run "
+                      "times: run it without mpirun (each run is serial); to time a case on N "
+                      "ranks use mpirun -np N mpsflow -parallel -case DIR",
+                      command);
+    if (rc != 0) {
+        if (root)
+            mf_error_print(stderr);
+        HYPRE_Finalize();
+        MPI_Finalize();
+        return 2;
+    }
+    if (rc == 0)
+        rc = mf_registry_create(&app.reg);
     if (rc == 0) {
         set_plugin_dirs(app.reg);
         rc = mf_register_builtins(app.reg);
@@ -243,15 +285,17 @@ int main(int argc, char **argv)
     double error = 0;
     if (rc == 0 && !command)
         rc = mf_cmd_run(&app);
-    else if (rc == 0 && !strcmp(command, "modules"))
+    else if (rc == 0 && !strcmp(command, "modules") && root)
         rc = mf_cmd_modules(app.reg, module_name);
-    else if (rc == 0 && !strcmp(command, "validate"))
-        rc = mf_cmd_validate(app.opt.case_dir, &error);
+    else if (rc == 0 && !strcmp(command, "validate") && root)
+        rc = mf_cmd_validate(app.opt.case_dir, &error); /* reads output/: one rank is enough */
     else if (rc == 0 && !strcmp(command, "compare"))
         rc = mf_cmd_compare(app.opt.case_dir, app.opt.solvers, app.opt.resolutions);
     else if (rc == 0 && !strcmp(command, "stability"))
         rc = mf_cmd_stability(app.opt.case_dir, app.opt.solvers, app.opt.sweeps);
-    if (rc != 0)
+    /* A failure every rank agreed on is printed once; one that a rank met
+     * alone is printed by that rank. */
+    if (rc != 0 && (root || !app.error_agreed))
         mf_error_print(stderr);
     mf_app_teardown(&app);
     mf_registry_destroy(app.reg);

@@ -17,6 +17,7 @@ typedef struct mf_options {
     double l0;              /* -l0 overrides particleSpacing (0: no) */
     double end_time;        /* -endTime overrides controlDict (0: no) */
     bool dry_run, latest_time;
+    bool parallel;          /* -parallel: one case on the ranks mpirun started */
     int log_level;
 } mf_options;
 
@@ -30,6 +31,7 @@ typedef struct mf_app {
     size_t nfunctions;
     mf_module *functions;
     mf_run run;
+    bool error_agreed;      /* a -parallel run's failure is known to every rank */
 } mf_app;
 
 /* Register every built-in module (the one explicit call). */
@@ -42,6 +44,16 @@ int mf_app_setup(mf_app *app);
 void mf_app_teardown(mf_app *app);
 /* Print counts, kernel constants and memory (-dryRun). */
 void mf_app_summary(const mf_app *app);
+
+/* parallel_setup.c: -parallel. Started on several ranks without it: an
+ * error saying what to type. */
+int mf_app_check_parallel(const mf_options *opt, int argc, char **argv);
+/* sim.par from system/decomposeParDict (NULL on one rank: the serial run). */
+int mf_app_create_parallel(mf_app *app, mf_dict *resolved);
+/* Each rank keeps its subdomain of the particles every rank holds. */
+int mf_app_distribute(mf_app *app);
+/* The decomposition's figures at the end of a -parallel run (the log). */
+void mf_app_report_parallel(const mf_app *app);
 
 /* output/runSummary: how the run ended (status is its return code). */
 int mf_write_run_summary(const mf_app *app, int status);

@@ -90,6 +90,8 @@ static int hdf5_write(void *data, const mf_sim *sim, const mf_dict *params)
     MF_CALL(mf_h5_snapshot_path(w->output_dir, w->next_index, path, sizeof path));
     MF_CALL(mf_hdf5_write_snapshot(path, sim, params, w->compression));
     int index = w->next_index++;
+    if (!mf_parallel_is_root(sim->par))
+        return 0; /* one index file, written by rank 0 */
     mf_xdmf_snap s;
     MF_CALL(mf_xdmf_describe(w->output_dir, index, &s));
     MF_CALL(mf_xdmf_index_add(&w->xdmf, &s));
