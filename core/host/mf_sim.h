@@ -12,6 +12,7 @@
 #include "mf_dict.h"
 #include "mf_log.h"
 #include "mf_neighbours.h"
+#include "mf_halo.h"
 #include "mf_parallel.h"
 #include "mf_particles.h"
 #include "mf_registry.h"
@@ -80,6 +81,11 @@ typedef struct mf_sim {
     mf_log *log;
     /* The ranks of a -parallel run (mf_parallel.h); NULL for a serial run. */
     mf_parallel *par;
+    /* The copies [n_owned, n) of the particles while a solver's step runs
+     * (mf_halo.h: other ranks' particles, periodic images), for a force that
+     * needs its own intermediate values on them (mf_halo_update); NULL when
+     * there are none. */
+    mf_halo *halo;
     /* Statistics the driver reports (filled by modules). */
     double courant_mean, courant_max;
     long pressure_iterations;  /* summed over the run */

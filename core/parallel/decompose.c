@@ -279,6 +279,7 @@ int mf_parallel_balance(mf_parallel *par, mf_particles *p, bool force)
     if (p->n != p->n_owned)
         return MF_ERROR(MF_ERR_INTERNAL, "mf_parallel_balance: drop the halo first");
     if (!par->partitioned || force) {
+        par->stats.imbalance_before = mf_parallel_imbalance(par, p);
         MF_CALL(partition(par, p));
         mf_parallel_imbalance(par, p);
         return 0;
@@ -312,6 +313,9 @@ int mf_parallel_distribute(mf_parallel *par, mf_particles *p, int64_t first_new_
     free(drop);
     MF_CALL(mf_parallel_agree(par, rc));
     mf_particles_set_id_block(p, first_new_id, par->rank, par->size);
-    MF_CALL(mf_parallel_balance(par, p, true));
+    if (par->s.first_partition)
+        MF_CALL(mf_parallel_balance(par, p, true));
+    else
+        mf_parallel_imbalance(par, p);
     return 0;
 }

@@ -45,6 +45,10 @@ typedef struct mf_parallel_settings {
     /* Load of one particle of each kind, relative to a fluid particle (the
      * walls and dummies of a scene do less work a step than its fluid). */
     double weight[MF_NKINDS];
+    /* false: mf_parallel_distribute leaves each rank its contiguous share of
+     * the particles in the order they were built, and the first step makes
+     * the first partition (a deliberately unbalanced start, for tests). */
+    bool first_partition;
 } mf_parallel_settings;
 
 void mf_parallel_default_settings(mf_parallel_settings *s);
@@ -93,6 +97,18 @@ int64_t mf_parallel_exscan(const mf_parallel *par, int64_t v);
 /* The largest value over the ranks and the rank that holds it (the lowest
  * such rank on a tie). */
 void mf_parallel_maxloc(const mf_parallel *par, double *v, int *rank);
+/* A particle as every rank learns of it (the fastest, the thinnest, ...). */
+typedef struct mf_particle_info {
+    bool found;
+    int kind;
+    int64_t id;
+    double x[3], v[3];
+} mf_particle_info;
+/* Particle i of this rank (SIZE_MAX: none) with *value; on return *value is
+ * the largest over the ranks and *out describes that rank's particle, on
+ * every rank (serial: particle i itself). */
+void mf_parallel_argmax(const mf_parallel *par, double *value, const mf_particles *p, size_t i,
+                        mf_particle_info *out);
 /* Copy bytes from rank `root` to every rank. */
 void mf_parallel_bcast(const mf_parallel *par, void *buf, size_t bytes, int root);
 /* bytes from each rank, concatenated in rank order into all (size * bytes). */

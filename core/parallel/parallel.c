@@ -17,6 +17,7 @@ void mf_parallel_default_settings(mf_parallel_settings *s)
     s->weight[MF_DUMMY] = 0.25;
     s->weight[MF_INLET] = 1.0;
     s->weight[MF_OUTLET] = 1.0;
+    s->first_partition = true;
 }
 
 int mf_parallel_world_size(void)
@@ -151,6 +152,22 @@ void mf_parallel_maxloc(const mf_parallel *par, double *v, int *rank)
     *v = out.value;
     if (rank)
         *rank = out.rank;
+}
+
+void mf_parallel_argmax(const mf_parallel *par, double *value, const mf_particles *p, size_t i,
+                        mf_particle_info *out)
+{
+    memset(out, 0, sizeof *out);
+    int who = 0;
+    mf_parallel_maxloc(par, value, &who);
+    if (mf_parallel_rank(par) == who && i != SIZE_MAX && i < p->n) {
+        out->found = true;
+        out->kind = p->kind[i];
+        out->id = p->id[i];
+        memcpy(out->x, &p->pos[3 * i], sizeof out->x);
+        memcpy(out->v, &p->vel[3 * i], sizeof out->v);
+    }
+    mf_parallel_bcast(par, out, sizeof *out, who);
 }
 
 void mf_parallel_bcast(const mf_parallel *par, void *buf, size_t bytes, int root)

@@ -5,6 +5,8 @@
  * case has one (OpenFOAM's file name; every key optional):
  *
  *   method              RCB;   // or HSFC (Zoltan's Hilbert space-filling curve)
+ *   firstPartition      zoltan; // none: keep the scene's build order until the first
+ *                              // step (a deliberately unbalanced start)
  *   imbalanceThreshold  1.1;   // a new partition when the heaviest rank carries
  *                              // more than this times the mean load
  *   weights { fluid 1; wall 1; dummy 0.25; inlet 1; outlet 1; }
@@ -23,6 +25,7 @@
 
 typedef struct decompose_settings {
     const char *method;
+    const char *first_partition;
     double imbalance_threshold;
     const mf_dict *weights;
 } decompose_settings;
@@ -32,10 +35,15 @@ typedef struct weight_settings {
 } weight_settings;
 
 static const char *const methods[] = {"RCB", "HSFC", NULL};
+static const char *const first_partitions[] = {"zoltan", "none", NULL};
 
 static const mf_param decompose_params[] = {
     {"method", MF_PARAM_WORD, "RCB", MF_NO_RANGE, methods, offsetof(decompose_settings, method),
      "Zoltan partitioner: RCB (recursive coordinate bisection) or HSFC (Hilbert curve)"},
+    {"firstPartition", MF_PARAM_WORD, "zoltan", MF_NO_RANGE, first_partitions,
+     offsetof(decompose_settings, first_partition),
+     "zoltan: partition at the start; none: each rank keeps its share of the scene in build "
+     "order until the first step (a deliberately unbalanced start)"},
     {"imbalanceThreshold", MF_PARAM_SCALAR, "1.1", 1.0, 100, NULL,
      offsetof(decompose_settings, imbalance_threshold),
      "a new partition when the heaviest rank's load exceeds this times the mean"},
@@ -101,6 +109,7 @@ int mf_app_create_parallel(mf_app *app, mf_dict *resolved)
     if (rc == 0) {
         s.method = strcmp(ds.method, "HSFC") == 0 ? MF_DECOMPOSE_HSFC : MF_DECOMPOSE_RCB;
         s.imbalance_threshold = ds.imbalance_threshold;
+        s.first_partition = strcmp(ds.first_partition, "none") != 0;
         memcpy(s.weight, ws.w, sizeof s.weight);
         rc = mf_parallel_create(&s, &app->sim.par);
     }

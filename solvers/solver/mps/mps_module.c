@@ -67,6 +67,7 @@ int mps_create_data(const mps_settings *s, mf_sim *sim, const mf_dict *solver_di
     if (strcmp(s->viscosity, "implicit") == 0)
         MF_CALL(mps_viscosity_create(d, sim));
     MF_CALL(mps_reserve(d, sim->p->n));
+    MF_CALL(mps_halo_create(d, sim)); /* copies from other ranks (none in a serial run) */
     const mf_kernel *ks[3] = {&d->k_nd, &d->k_grad, &d->k_lap};
     const char *names[3] = {"number density", "gradient", "Laplacian"};
     for (int k = 0; k < 3; k++)
@@ -85,7 +86,7 @@ void mps_destroy_data(mps_data *d)
         d->pressure_ops->destroy(d->pressure.data);
     mf_module_release(&d->pressure);
     mps_viscosity_destroy(d->visc);
-    mps_periodic_destroy(d->periodic);
+    mps_halo_destroy(d->halo);
     mf_grid_free(&d->grid);
     mf_nlist_free(&d->nl_max);
     mf_nlist_free(&d->nl_nd);
@@ -114,19 +115,18 @@ static int mps_create(const void *settings, mf_sim *sim, const mf_dict *solver_d
                         "use solver multiFluid",
                         sim->nfluids, sim->fluid[0].name, sim->fluid[1].name,
                         sim->nfluids > 2 ? ", ..." : "");
-    /* Only this solver has a periodic axis (mps_periodic.c): the composing
+    /* Only this solver has a periodic axis (mps_halo.c): the composing
      * solvers call the phases themselves. */
     mps_settings s = *(const mps_settings *)settings;
     const double period = s.periodic_length;
     s.periodic_length = 0;
     mps_data *d = NULL;
     int rc = mps_create_data(&s, sim, solver_dict, &d);
-    if (rc == 0 && period > 0) {
+    if (rc == 0 && period > 0) { /* the halo of mps_create_data gains the period */
+        mps_halo_destroy(d->halo);
+        d->halo = NULL;
         d->s.periodic_length = period;
-        double rmax = d->k_nd.re;
-        if (d->k_grad.re > rmax) rmax = d->k_grad.re;
-        if (d->k_lap.re > rmax) rmax = d->k_lap.re;
-        rc = mps_periodic_create(d, sim, rmax);
+        rc = mps_halo_create(d, sim);
     }
     if (rc != 0) {
         mps_destroy_data(d);

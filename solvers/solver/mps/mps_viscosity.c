@@ -142,10 +142,10 @@ static int assemble(mps_data *d, const mf_sim *sim, double dt, double *dirichlet
     for (size_t i = 0; i < p->n_owned; i++) {
         if (!d->is_fluid[i])
             continue;
-        size_t r = (size_t)v->row[i];
+        size_t r = (size_t)(v->row[i] - A->row_offset);
         A->rowptr[r] = pos;
         size_t diag = pos++;
-        A->col[diag] = A->row_offset + (int64_t)r;
+        A->col[diag] = v->row[i];
         double sum = 0.0, known[3] = {0.0, 0.0, 0.0};
         for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
             size_t j = nl->j[k];
@@ -158,7 +158,7 @@ static int assemble(mps_data *d, const mf_sim *sim, double dt, double *dirichlet
             double a = pair_coef(d, i, j, fluid, nu, dtc, w);
             sum += a;
             if (fluid) {
-                A->col[pos] = A->row_offset + v->row[mps_owner(d, p, j)];
+                A->col[pos] = v->row[j]; /* global: a copy holds its owner's */
                 A->val[pos++] = -a;
             } else {
                 for (int c = 0; c < 3; c++)
@@ -184,12 +184,13 @@ int mps_viscosity_implicit(mps_data *d, mf_sim *sim, double dt)
         if (d->is_fluid[i])
             nnz += 1 + (nl->start[i + 1] - nl->start[i]);
     }
-    for (size_t j = p->n_owned; j < p->n; j++) /* periodic images: their owner's row */
-        v->row[j] = v->row[mps_owner(d, p, j)];
+    /* Global rows; copies (images, other ranks' particles) take their owners'. */
+    int64_t offset = 0, nglobal = 0;
+    MF_CALL(mps_global_rows(d, sim, v->row, rows, &offset, &nglobal));
     MF_CALL(reserve(v, p->n, rows, nnz));
     v->A.nrows = rows;
-    v->A.row_offset = p->global_offset;
-    v->A.nglobal = (int64_t)rows; /* one rank */
+    v->A.row_offset = offset;
+    v->A.nglobal = nglobal;
     double *dirichlet = malloc(3 * (rows ? rows : 1) * sizeof *dirichlet);
     if (!dirichlet)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu viscous unknowns", rows);
@@ -199,9 +200,9 @@ int mps_viscosity_implicit(mps_data *d, mf_sim *sim, double dt)
     for (int c = 0; rc == 0 && c < sim->dim; c++) {
         /* b = rho_i (u^n + dt a) + walls; the guess: u^n + dt a. */
         for (size_t i = 0; i < p->n_owned; i++) {
-            long r = v->row[i];
-            if (r < 0)
+            if (v->row[i] < 0)
                 continue;
+            const long r = v->row[i] - (long)offset;
             const double ut = p->vel[3 * i + c] + dt * d->acc[3 * i + c];
             v->x[r] = ut;
             v->b[r] = (d->rho ? d->rho[i] : 1.0) * ut + dirichlet[3 * r + c];
@@ -218,7 +219,7 @@ int mps_viscosity_implicit(mps_data *d, mf_sim *sim, double dt)
         if (rc == 0)
             for (size_t i = 0; i < p->n_owned; i++)
                 if (v->row[i] >= 0)
-                    p->vel[3 * i + c] = v->x[v->row[i]];
+                    p->vel[3 * i + c] = v->x[v->row[i] - offset];
     }
     v->seconds += mf_wall_seconds() - t0;
     free(dirichlet);
@@ -228,10 +229,7 @@ int mps_viscosity_implicit(mps_data *d, mf_sim *sim, double dt)
                 p->vel[3 * i + c] += dt * d->acc[3 * i + c];
     if (rc != 0)
         return mf_error_trace(rc, __FILE__, __LINE__, __func__);
-    /* The velocity of images follows their owners (the collision model reads it). */
-    if (d->image_owner)
-        for (size_t j = p->n_owned; j < p->n; j++)
-            memcpy(&p->vel[3 * j], &p->vel[3 * mps_owner(d, p, j)], 3 * sizeof(double));
+    /* The copies' velocities follow after the explicit phase (mps_step.c). */
     for (size_t i = 0; i < p->n_owned; i++)
         if (d->is_fluid[i])
             for (int c = 0; c < 3; c++)
