@@ -84,7 +84,7 @@ expect "restart without snapshots" "no snapshot to restart from.*-latestTime" -c
 # clean stop; every snapshot left behind must be whole.
 fresh; sed -i 's/    tolerance       1e-8;/    tolerance 1e-8; maxIter 2;/' "$dir/case/system/solverDict"
 expect "solve not converging" "retrying with deltaT.*retry 4 of 4" -case "$dir/case" -endTime 0.05
-expect "  ... then stopping" "not converged after 2 iterations" -case "$dir/case" -endTime 0.05
+expect "  ... then stopping" "not converged after 2 iterations" -case "$dir/case" -endTime 0.05 -overwrite
 for f in "$dir"/case/output/snapshot_*.h5; do
     if h5dump -H "$f" > /dev/null 2>&1; then passed=$((passed + 1)); else
         echo "FAIL snapshot $f is not readable after the failed run"; failed=$((failed + 1)); fi

@@ -5,14 +5,17 @@
 # each binary PLY and must find the vertex and face counts of its header.
 # Skipped (77) where Blender is not installed (apt-get install blender); it
 # is not a build dependency.
-# argv: mpsflow, tutorials/damBreak3D, tests/blender_check.py
+# Then the whole sequence of frames through tutorials/scripts/
+# mpsflowBlenderImport.py: one animation, upright in Blender's z-up axes.
+# argv: mpsflow, tutorials/damBreak3D, tests/blender_check.py, the folder of
+# mpsflowBlenderImport.py
 command -v blender > /dev/null || { echo "blender not found: skipped"; exit 77; }
-mpsflow=$1; tutorial=$2; script=$3
+mpsflow=$1; tutorial=$2; script=$3; helpers=$4
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
 cp -r "$tutorial/." "$dir/"
 rm -rf "$dir/output" "$dir/postProcessing"
-OMP_NUM_THREADS=1 "$mpsflow" -case "$dir" -l0 0.025 -endTime 0.01 -quiet > "$dir/log" 2>&1 ||
+OMP_NUM_THREADS=1 "$mpsflow" -case "$dir" -l0 0.025 -endTime 0.02 -quiet > "$dir/log" 2>&1 ||
     { cat "$dir/log"; exit 1; }
 status=0
 for method in blobby levelSet; do
@@ -32,4 +35,12 @@ for method in blobby levelSet; do
         status=1
     fi
 done
+rm -rf "$dir/postProcessing"
+OMP_NUM_THREADS=1 "$mpsflow" surface -case "$dir" -method blobby > "$dir/log.sequence" 2>&1 ||
+    { cat "$dir/log.sequence"; exit 1; }
+n=$(ls "$dir"/postProcessing/surface/surface_*.ply | wc -l)
+out=$(BLENDER_SEQUENCE=$n timeout 300 blender -b --factory-startup --python "$helpers/mpsflowBlenderImport.py" \
+      --python "$script" -- "$dir" 2>&1)
+echo "$out" | grep "^BLENDER_SEQUENCE\|^MPSFLOW_BLENDER"
+echo "$out" | grep -q "^BLENDER_SEQUENCE ok" || { echo "$out" | tail -n 20; status=1; }
 exit $status

@@ -334,8 +334,14 @@ static void check_xdmf(const char *output_dir, int nsnapshots)
         CHECK_MSG(strstr(text, name) != NULL, "index lists %s", name);
     }
     CHECK(strstr(text, "StorageIndex") == NULL);
-    CHECK(strstr(text, "Name=\"Velocities\" AttributeType=\"Vector\"") != NULL);
-    CHECK(strstr(text, "Name=\"Pressure\" AttributeType=\"Scalar\"") != NULL);
+    CHECK(strstr(text, "Name=\"Velocities [m/s]\" AttributeType=\"Vector\"") != NULL);
+    CHECK(strstr(text, "Name=\"Pressure [Pa]\" AttributeType=\"Scalar\"") != NULL);
+    /* Vertex cells for the Xdmf3 readers; Kind shown, PointIndex not. */
+    CHECK(strstr(text, "NodesPerElement=\"1\"") != NULL);
+    CHECK(strstr(text, ":/PartType0/PointIndex</DataItem>\n        </Topology>") != NULL);
+    CHECK(strstr(text, "<Attribute Name=\"PointIndex\"") == NULL);
+    CHECK(strstr(text, "Name=\"Kind\" AttributeType=\"Scalar\"") != NULL);
+    CHECK(strstr(text, "NumberType=\"UChar\" Precision=\"1\"") != NULL);
 
     int nitems = 0;
     for (const char *s = text; (s = strstr(s, "<DataItem Dimensions=\"")) != NULL;) {

@@ -204,7 +204,9 @@ static void part_cases(void)
             memset(&got, 0, sizeof got);
             if (make_case(&c, cs, tag, 50, 50) == 0 && run(&c, np, cs, NULL) == 0 &&
                 load_last(&c, &got) == 0) {
-                CHECK(tc_case_log_contains(&c, "nProcs"));
+                char banner[32];
+                snprintf(banner, sizeof banner, "nProcs : %d", np);
+                CHECK(tc_case_log_contains(&c, banner));
                 compare(what, &ref, &got, l0);
             } else {
                 CHECK_MSG(0, "%s: the run", what);

@@ -100,6 +100,9 @@ typedef struct mf_writer_ops {
     /* Optional: restore particles, time and step from the newest snapshot.
      * Returns MF_ERR_INPUT if there is none. */
     int (*read_latest)(void *data, mf_sim *sim);
+    /* Optional (purgeWrite): delete the snapshots this writer wrote but the
+     * newest `keep`; the initial state (snapshot 0) is never deleted. */
+    int (*purge)(void *data, long keep);
 } mf_writer_ops;
 
 /* ---- surface reconstructor (level set, blobby) --------------------------- */

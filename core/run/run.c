@@ -1,5 +1,6 @@
 /* run.c: the time loop. */
 #include "mf_run.h"
+#include "mf_run_internal.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -203,6 +204,7 @@ static int write_now(mf_run *run)
             MF_CALL(fo->write(run->functions[k].data, run->sim));
     }
     run->writes++;
+    MF_CALL(mf_run_after_write(run));
     return 0;
 }
 
@@ -293,11 +295,8 @@ int mf_run_loop(mf_run *run, bool write_initial)
     saved_state saved;
     memset(&saved, 0, sizeof saved);
     const double t0 = mf_wall_seconds(), c0 = mf_cpu_seconds();
-    const double interval = run->ctl.write_interval;
     /* Next write time: the first multiple of the interval after now. */
-    double next_write = run->ctl.write_by_steps
-                            ? (double)(sim->step + (long)interval)
-                            : interval * (floor(sim->time / interval + 1e-9) + 1);
+    double next_write = mf_run_first_write(run);
     int rc = 0;
     /* Inlets and outlets exchange energy with the outside (the inflow's
      * kinetic energy, the pressure work at the open ends) that the watch
@@ -339,15 +338,22 @@ int mf_run_loop(mf_run *run, bool write_initial)
         }
         bool write = run->ctl.write_by_steps ? (double)sim->step >= next_write - 0.5
                                              : sim->time >= next_write * (1 - 1e-9);
-        if (write || sim->time >= sim->end_time * (1 - 1e-12)) {
+        bool wrote = write || sim->time >= sim->end_time * (1 - 1e-12);
+        if (wrote) {
             MF_CALL_GOTO(rc, write_now(run), done);
             while (next_write <= (run->ctl.write_by_steps ? (double)sim->step : sim->time * (1 + 1e-9)))
-                next_write += interval;
+                next_write += run->ctl.write_interval;
         }
         double wall = mf_wall_seconds() - t0;
         mf_log_printf(sim->log, MF_LOG_STEP, "ExecutionTime = %.3f s  ClockTime = %.0f s\n\n",
                       mf_cpu_seconds() - c0, wall);
         mf_log_progress(sim->log, sim->time, sim->end_time, wall);
+        bool stop = false, write_extra = false;
+        MF_CALL_GOTO(rc, mf_run_between_steps(run, wrote, &next_write, &stop, &write_extra), done);
+        if (write_extra)
+            MF_CALL_GOTO(rc, write_now(run), done);
+        if (stop)
+            break;
     }
     mf_log_progress_end(sim->log);
 done:

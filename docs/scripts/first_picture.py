@@ -31,8 +31,8 @@ except AttributeError:
 display = Show(reader, view)
 display.SetRepresentationType("Points")
 display.PointSize = 3
-ColorBy(display, ("POINTS", "Velocities", "Magnitude"))
-lut = GetColorTransferFunction("Velocities")
+ColorBy(display, ("POINTS", "Velocities [m/s]", "Magnitude"))
+lut = GetColorTransferFunction("Velocities [m/s]")
 lut.ApplyPreset("Viridis (matplotlib)", True)
 lut.RescaleTransferFunction(0.0, 3.0)
 bar = GetScalarBar(lut, view)

@@ -7,6 +7,9 @@
  * one line per scheme, points labelled by resolution) and prints which runs
  * are on the Pareto front (no other run is both faster and more accurate).
  *
+ * -l0 VALUE is one resolution for every scheme; -endTime VALUE is every
+ * run's end time.
+ *
  * Schemes: see mf_case_apply_scheme (a variant of system/compareDict or a
  * solver module). Each run is a copy of the case in DIR/compare/<scheme>_l0_<l0>/, run by a
  * child mpsflow process so that its peak memory is its own.
@@ -97,8 +100,17 @@ static void write_report(const char *case_dir, compare_row *rows, size_t n)
     }
 }
 
-int mf_cmd_compare(const char *case_dir, const char *solvers, const char *resolutions)
+int mf_cmd_compare(const mf_options *o)
 {
+    const char *case_dir = o->case_dir, *solvers = o->solvers, *resolutions = o->resolutions;
+    char end_text[64], one_l0[80];
+    snprintf(end_text, sizeof end_text, "%.10g", o->end_time);
+    if (o->l0 > 0 && resolutions)
+        return MF_ERROR(MF_ERR_INPUT, "compare: give -resolutions '(l0 ...)' or -l0, not both");
+    if (o->l0 > 0) { /* one spacing for every scheme */
+        snprintf(one_l0, sizeof one_l0, "(%.10g)", o->l0);
+        resolutions = one_l0;
+    }
     if (!solvers || !resolutions)
         return MF_ERROR(MF_ERR_INPUT, "compare needs -solvers '(A B ...)' and -resolutions "
                         "'(l0 ...)', e.g. mpsflow compare -case tutorials/hydrostatic2D "
@@ -133,7 +145,8 @@ int mf_cmd_compare(const char *case_dir, const char *solvers, const char *resolu
             if (rc != 0)
                 break;
             snprintf(log_path, sizeof log_path, "%s/log.mpsflow", run_dir);
-            char *argv[] = {NULL, "-case", run_dir, "-l0", l0_text, "-quiet", NULL};
+            char *argv[] = {NULL, "-case", run_dir, "-l0", l0_text, "-quiet",
+                            o->end_time > 0 ? "-endTime" : NULL, end_text, NULL};
             printf("compare: %s at l0 = %s ... ", scheme, l0_text);
             rc = mf_run_child(argv, log_path, &row->child);
             if (rc != 0)

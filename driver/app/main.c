@@ -1,7 +1,9 @@
 /* main.c: `mpsflow`, with OpenFOAM's habits.
  *
- *   mpsflow [-case DIR] [-solver NAME] [-libs '(...)'] [-dryRun] [-latestTime]
- *   mpsflow modules [NAME]
+ *   mpsflow [-case DIR] [-solver NAME] [-libs '(...)'] [-dryRun] [-latestTime] [-overwrite]
+ *   mpsflow -postProcess -func NAME | -funcs '(A B)' [-time T | -latestTime]
+ *   mpsflow listTimes | modules [NAME] | validate | compare | stability | surface
+ *   mpsflow -version
  *   mpirun -np N mpsflow -parallel -case DIR     (one case on N ranks)
  */
 #include <limits.h>
@@ -30,6 +32,8 @@ static void usage(FILE *f)
             "                    map stable and unstable runs (-solvers '(A B)' [-sweeps '(...)'])\n"
             "  surface           reconstruct the free surface of the snapshots as meshes\n"
             "                    (-time T | -latestTime, -method levelSet|blobby; surface -help)\n"
+            "  listTimes         the times of the snapshots in DIR/output (-time, -latestTime;\n"
+            "                    -verbose: step, file and particle counts too)\n"
             "\n"
             "Options:\n"
             "  -case DIR         case directory (default: the current folder)\n"
@@ -37,14 +41,20 @@ static void usage(FILE *f)
             "  -libs '(...)'     plugin libraries to load, e.g. -libs '(libkineticEnergy.so)'\n"
             "  -dryRun           read the case, build the scene, print a summary, stop\n"
             "  -latestTime       restart from the newest snapshot in DIR/output\n"
+            "                    (listTimes, -postProcess: only the newest snapshot)\n"
+            "  -overwrite        a new run replaces an earlier one's output/ and postProcessing/\n"
+            "                    (without it a new run over an earlier output/ is refused)\n"
+            "  -postProcess      replay function objects or metrics over the existing snapshots:\n"
+            "                    -func NAME or -funcs '(A B)' (controlDict functions, function\n"
+            "                    object types, validation metrics); -time T selects snapshots\n"
+            "  -time T           a time (the nearest snapshot), a list 0.1,0.2 or a range 0.1:0.5\n"
             "  -l0 VALUE         particle spacing, overriding constant/geometry (coarse/fine)\n"
-            "  -parallel         run one case on the ranks of mpirun -np N (decomposition:\n"
-            "                    system/decomposeParDict, optional)\n"
             "  -endTime VALUE    end time, overriding system/controlDict\n"
             "  -solvers '(...)'  compare: schemes (variants of system/compareDict, or solvers)\n"
             "  -resolutions '(...)'  compare: particle spacings\n"
             "  -sweeps '(...)'   stability: only these sweeps\n"
             "  -quiet, -verbose  less or more log\n"
+            "  -version          the version and build of this mpsflow\n"
             "  -help             this text\n"
             "\n"
             "Plugins are searched as named, then in MPSFLOW_PLUGIN_PATH, then in the\n"
@@ -67,7 +77,9 @@ static int parse_options(int argc, char **argv, int first, mf_options *opt)
 {
     static const char *const known[] = {"-case", "-solver", "-libs", "-dryRun", "-latestTime",
                                         "-l0", "-endTime", "-quiet", "-verbose", "-help",
-                                        "-solvers", "-resolutions", "-sweeps", "-parallel"};
+                                        "-solvers", "-resolutions", "-sweeps", "-overwrite",
+                                        "-postProcess", "-func", "-funcs", "-time", "-version",
+                                        "-parallel"};
     for (int i = first; i < argc; i++) {
         const char *a = argv[i];
         bool has_value = i + 1 < argc;
@@ -77,15 +89,22 @@ static int parse_options(int argc, char **argv, int first, mf_options *opt)
             opt->dry_run = true;
         else if (!strcmp(a, "-latestTime"))
             opt->latest_time = true;
+        else if (!strcmp(a, "-overwrite"))
+            opt->overwrite = true;
         else if (!strcmp(a, "-parallel"))
             opt->parallel = true;
+        else if (!strcmp(a, "-postProcess"))
+            opt->post_process = true;
+        else if (!strcmp(a, "-version"))
+            opt->version = true;
         else if (!strcmp(a, "-quiet"))
             opt->log_level = MF_LOG_QUIET;
         else if (!strcmp(a, "-verbose"))
             opt->log_level = MF_LOG_VERBOSE;
         else if (!strcmp(a, "-case") || !strcmp(a, "-solver") || !strcmp(a, "-libs") ||
                  !strcmp(a, "-l0") || !strcmp(a, "-endTime") || !strcmp(a, "-solvers") ||
-                 !strcmp(a, "-resolutions") || !strcmp(a, "-sweeps")) {
+                 !strcmp(a, "-resolutions") || !strcmp(a, "-sweeps") || !strcmp(a, "-func") ||
+                 !strcmp(a, "-funcs") || !strcmp(a, "-time")) {
             if (!has_value)
                 return MF_ERROR(MF_ERR_INPUT, "option %s needs a value (see mpsflow -help)", a);
             const char *v = argv[++i];
@@ -101,6 +120,12 @@ static int parse_options(int argc, char **argv, int first, mf_options *opt)
                 opt->resolutions = v;
             else if (!strcmp(a, "-sweeps"))
                 opt->sweeps = v;
+            else if (!strcmp(a, "-func"))
+                opt->func = v;
+            else if (!strcmp(a, "-funcs"))
+                opt->funcs = v;
+            else if (!strcmp(a, "-time"))
+                opt->time = v;
             else if (!strcmp(a, "-l0"))
                 MF_CALL(parse_number(a, v, &opt->l0));
             else
@@ -111,11 +136,19 @@ static int parse_options(int argc, char **argv, int first, mf_options *opt)
                             hint ? "; did you mean '" : "", hint ? hint : "", hint ? "'?" : "");
         }
     }
+    if (opt->time && opt->latest_time)
+        return MF_ERROR(MF_ERR_INPUT, "-time and -latestTime exclude each other");
     return 0;
 }
 
 /* Plugins built with mpsflow sit in ../plugins beside driver/ in the build
- * tree, or in ../lib/mpsflow beside bin/ when installed. */
+ * tree, or, installed, in the plugin folder at MPSFLOW_PLUGIN_RELDIR from
+ * bin/ (meson's libdir/mpsflow: ../lib/x86_64-linux-gnu/mpsflow on Debian),
+ * found from where the executable is, so that an installed tree works
+ * wherever it is put (meson install --destdir, a moved prefix). */
+#ifndef MPSFLOW_PLUGIN_RELDIR
+#define MPSFLOW_PLUGIN_RELDIR "../lib/mpsflow"
+#endif
 static void set_plugin_dirs(mf_registry *reg)
 {
     char exe[PATH_MAX], dirs[3 * PATH_MAX];
@@ -127,7 +160,10 @@ static void set_plugin_dirs(mf_registry *reg)
     if (!slash)
         return;
     *slash = '\0';
-    snprintf(dirs, sizeof dirs, "%s/../plugins:%s/../lib/mpsflow", exe, exe);
+    if (MPSFLOW_PLUGIN_RELDIR[0] == '/')
+        snprintf(dirs, sizeof dirs, "%s/../plugins:%s", exe, MPSFLOW_PLUGIN_RELDIR);
+    else
+        snprintf(dirs, sizeof dirs, "%s/../plugins:%s/%s", exe, exe, MPSFLOW_PLUGIN_RELDIR);
     mf_registry_set_plugin_dir(reg, dirs);
 }
 
@@ -164,7 +200,7 @@ int mf_cmd_modules(mf_registry *reg, const char *name)
 /* The run itself; every rank of a -parallel run calls it. */
 static int run_case(mf_app *app)
 {
-    bool restart = app->opt.latest_time || !strcmp(app->cs.control.start_from, "latestTime");
+    bool restart = mf_app_is_restart(app);
     if (restart) {
         const mf_writer_ops *w = (const mf_writer_ops *)app->writer.info;
         if (!w->read_latest)
@@ -177,7 +213,16 @@ static int run_case(mf_app *app)
     if (mf_parallel_is_root(app->sim.par))
         MF_CALL(mf_case_write_resolved(&app->cs));
     mf_app_summary(app);
-    int rc = mf_run_loop(&app->run, !restart);
+    int rc = mf_run_signals_install();
+    if (rc == 0)
+        rc = mf_run_loop(&app->run, !restart);
+    mf_run_signals_restore();
+    if (rc == 0 && app->run.stop_reason[0])
+        mf_log_printf(&app->log, MF_LOG_QUIET, "\n--> %s at time %g (step %ld)%s\n",
+                      app->run.stop_reason, app->sim.time, app->sim.step,
+                      app->run.ctl.stop_at == MF_STOP_NO_WRITE_NOW && !app->run.stop_signal
+                          ? ""
+                          : "; the last snapshot holds this state");
     const mf_solver_ops *ops = (const mf_solver_ops *)app->solver.info;
     if (ops->report)
         ops->report(app->solver.data, &app->sim, &app->log);
@@ -187,10 +232,11 @@ static int run_case(mf_app *app)
                   "MB\n",
                   app->run.steps, app->run.retries, app->run.writes, app->run.wall_seconds,
                   mf_peak_memory() / 1048576.0);
-    if (mf_write_run_summary(app, rc) != 0 && rc == 0)
+    if (mf_parallel_is_root(app->sim.par) && mf_write_run_summary(app, rc) != 0 && rc == 0)
         return mf_error_trace(MF_ERR_IO, __FILE__, __LINE__, __func__);
     MF_CALL(rc);
     mf_log_printf(&app->log, MF_LOG_QUIET, "End\n");
+    fflush(stdout);
     return 0;
 }
 
@@ -218,10 +264,14 @@ int mf_cmd_run(mf_app *app)
 
 int main(int argc, char **argv)
 {
+    /* Whole lines reach a redirected log at once (tail -f, a kill). */
+    setvbuf(stdout, NULL, _IOLBF, 0);
     mf_app app;
     memset(&app, 0, sizeof app);
     app.opt.case_dir = ".";
     app.opt.log_level = MF_LOG_NORMAL;
+    app.opt.argc = argc;
+    app.opt.argv = argv;
     const char *command = NULL;
     int first = 1;
     if (argc > 1 && argv[1][0] != '-') {
@@ -244,7 +294,12 @@ int main(int argc, char **argv)
         mf_error_print(stderr);
         return 2;
     }
-    static const char *const commands[] = {"modules", "validate", "compare", "stability"};
+    if (app.opt.version) {
+        printf("%s\n", mf_app_version());
+        return 0;
+    }
+    static const char *const commands[] = {"modules", "validate", "compare", "stability",
+                                           "listTimes"};
     const size_t ncommands = sizeof commands / sizeof commands[0];
     bool known = !command;
     for (size_t k = 0; k < ncommands && !known; k++)
@@ -274,8 +329,7 @@ int main(int argc, char **argv)
         MPI_Finalize();
         return 2;
     }
-    if (rc == 0)
-        rc = mf_registry_create(&app.reg);
+    rc = mf_registry_create(&app.reg);
     if (rc == 0) {
         set_plugin_dirs(app.reg);
         rc = mf_register_builtins(app.reg);
@@ -283,23 +337,36 @@ int main(int argc, char **argv)
     if (rc == 0 && app.opt.libs)
         rc = mf_app_load_libs_text(app.reg, app.opt.libs);
     double error = 0;
-    if (rc == 0 && !command)
+    if (rc == 0 && !command && (app.opt.post_process || !app.opt.dry_run) && root)
+        mf_app_banner(stdout, argc, argv, app.opt.case_dir);
+    if (rc == 0 && !command && app.opt.post_process) {
+        if (root) /* replays snapshots serially: one rank is enough */
+            rc = mf_cmd_post_process(&app);
+    } else if (rc == 0 && !command)
         rc = mf_cmd_run(&app);
+    /* Commands that read a case's files: one rank is enough. */
+    else if (rc == 0 && !strcmp(command, "listTimes") && root)
+        rc = mf_cmd_list_times(&app.opt);
     else if (rc == 0 && !strcmp(command, "modules") && root)
         rc = mf_cmd_modules(app.reg, module_name);
     else if (rc == 0 && !strcmp(command, "validate") && root)
-        rc = mf_cmd_validate(app.opt.case_dir, &error); /* reads output/: one rank is enough */
+        rc = mf_cmd_validate(app.opt.case_dir, &error);
     else if (rc == 0 && !strcmp(command, "compare"))
-        rc = mf_cmd_compare(app.opt.case_dir, app.opt.solvers, app.opt.resolutions);
+        rc = mf_cmd_compare(&app.opt);
     else if (rc == 0 && !strcmp(command, "stability"))
-        rc = mf_cmd_stability(app.opt.case_dir, app.opt.solvers, app.opt.sweeps);
+        rc = mf_cmd_stability(&app.opt);
     /* A failure every rank agreed on is printed once; one that a rank met
      * alone is printed by that rank. */
     if (rc != 0 && (root || !app.error_agreed))
         mf_error_print(stderr);
+    fflush(stdout);
+    const int stop_signal = app.run.stop_signal;
     mf_app_teardown(&app);
     mf_registry_destroy(app.reg);
     HYPRE_Finalize();
     MPI_Finalize();
+    /* Stopped by SIGINT/SIGTERM: the shell's convention, 128 + signal. */
+    if (rc == 0 && stop_signal)
+        return 128 + stop_signal;
     return rc == 0 ? 0 : 1;
 }

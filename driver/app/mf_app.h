@@ -3,6 +3,9 @@
 #define MF_APP_H
 
 #include <stdbool.h>
+#include <stdio.h>
+#include <sys/types.h>
+#include <time.h>
 
 #include "mf_case.h"
 #include "mf_modules.h"
@@ -14,12 +17,26 @@ typedef struct mf_options {
     const char *solver;     /* -solver overrides solverDict */
     const char *libs;       /* -libs '(a b)' */
     const char *solvers, *resolutions, *sweeps; /* compare, stability */
+    const char *func, *funcs;   /* -postProcess -func NAME, -funcs '(A B)' */
+    const char *time;       /* -time: snapshots for listTimes and -postProcess */
+    bool post_process, version;
     double l0;              /* -l0 overrides particleSpacing (0: no) */
     double end_time;        /* -endTime overrides controlDict (0: no) */
     bool dry_run, latest_time;
     bool parallel;          /* -parallel: one case on the ranks mpirun started */
+    bool overwrite;         /* -overwrite: a fresh run may replace an earlier output/ */
     int log_level;
+    int argc;               /* the command line, for the log's banner */
+    char **argv;
 } mf_options;
+
+/* runTimeModifiable (modifiable.c): the controlDict values last read. */
+typedef struct mf_control_watch {
+    mf_control file;        /* as the file said (strings into tree or the case) */
+    mf_dict *tree;          /* the last re-read file, NULL before one */
+    struct timespec mtime;
+    off_t size;
+} mf_control_watch;
 
 typedef struct mf_app {
     mf_options opt;
@@ -32,6 +49,7 @@ typedef struct mf_app {
     mf_module *functions;
     mf_run run;
     bool error_agreed;      /* a -parallel run's failure is known to every rank */
+    mf_control_watch control_watch;
 } mf_app;
 
 /* Register every built-in module (the one explicit call). */
@@ -39,6 +57,10 @@ int mf_register_builtins(mf_registry *reg);
 
 /* Load plugins named in a list text such as "(libfoo.so bar)". */
 int mf_app_load_libs_text(mf_registry *reg, const char *text);
+/* The `libs` of one function's dictionary (functions { NAME { libs (...); } }). */
+int mf_app_load_function_libs(mf_registry *reg, const mf_dict *fd);
+/* Load the plugins of controlDict's `libs` (after the case is read). */
+int mf_app_load_case_libs(mf_app *app);
 /* Read the case, build the scene and create the modules it names. */
 int mf_app_setup(mf_app *app);
 void mf_app_teardown(mf_app *app);
@@ -55,19 +77,53 @@ int mf_app_distribute(mf_app *app);
 /* The decomposition's figures at the end of a -parallel run (the log). */
 void mf_app_report_parallel(const mf_app *app);
 
-/* output/runSummary: how the run ended (status is its return code). */
+/* output/runSummary: how the run ended (status is its return code; a run
+ * stopped early, by stopAt or a signal, says so from app->run.stop_reason). */
 int mf_write_run_summary(const mf_app *app, int status);
+
+/* -latestTime or startFrom latestTime. */
+bool mf_app_is_restart(const mf_app *app);
+/* A fresh run refuses an output/ that holds an earlier run, or removes it
+ * with -overwrite (output_check.c). */
+int mf_app_check_output(mf_app *app);
+
+/* runTimeModifiable (modifiable.c): remember controlDict as read and let
+ * the loop re-read it between steps (run->modified). */
+int mf_app_watch_control(mf_app *app);
+void mf_app_unwatch_control(mf_app *app);
+int mf_app_control_modified(void *ctx, mf_run *run);
+
+/* The log's first lines (banner.c): version, build, command line, date,
+ * host, PID, case, nProcs; as OpenFOAM's. */
+void mf_app_banner(FILE *f, int argc, char **argv, const char *case_dir);
+/* "mpsflow 0.1.0 (git ...)" for -version and file headers. */
+const char *mf_app_version(void);
 
 /* Commands. */
 int mf_cmd_run(mf_app *app);
 int mf_cmd_modules(mf_registry *reg, const char *name);
-/* `mpsflow validate -case DIR`: prints "error <metric> = <value>". */
+/* `mpsflow validate -case DIR`: prints "error <metric> = <value>"; fails
+ * (after printing it, marked) when the run did not reach its endTime. */
 int mf_cmd_validate(const char *case_dir, double *error);
+/* The metric `name` (NULL: the one validation/metric names; its settings
+ * come from there) over the selected snapshots (NULL: all), its report in
+ * out_dir. *used: the metric (may be NULL). */
+struct mf_metric;
+int mf_metric_evaluate(const char *case_dir, const char *name, const int *selected,
+                       size_t nselected, const char *out_dir, double *error,
+                       const struct mf_metric **used);
+/* Why output/runSummary says the run did not reach endTime ("" if it did);
+ * false when there is no runSummary. Clears the error trace. */
+bool mf_run_status_note(const char *case_dir, char *note, size_t len);
 
-/* `mpsflow compare`: see compare.c. */
-int mf_cmd_compare(const char *case_dir, const char *solvers, const char *resolutions);
+/* `mpsflow compare`: see compare.c (-endTime is passed to each run). */
+int mf_cmd_compare(const mf_options *o);
 
-/* `mpsflow stability`: see stability.c. */
-int mf_cmd_stability(const char *case_dir, const char *solvers, const char *sweeps);
+/* `mpsflow stability`: see stability.c (-l0 and -endTime passed to each run). */
+int mf_cmd_stability(const mf_options *o);
+
+/* `mpsflow listTimes` and `mpsflow -postProcess` (post_process.c). */
+int mf_cmd_list_times(const mf_options *o);
+int mf_cmd_post_process(mf_app *app);
 
 #endif

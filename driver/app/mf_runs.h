@@ -12,6 +12,7 @@ typedef struct mf_run_summary {
     char status[32];     /* completed | unstable | failed | "no summary" */
     char criterion[64];  /* the watch criterion, "none" or "other" */
     long steps, iterations, particles;
+    double time, end_time;   /* reached, and asked for */
 } mf_run_summary;
 
 typedef struct mf_child_result {

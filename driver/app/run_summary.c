@@ -37,10 +37,23 @@ int mf_write_run_summary(const mf_app *app, int status)
     if (!f)
         return MF_ERROR(MF_ERR_IO, "%s: cannot write (%s)", tmp, strerror(errno));
     const mf_sim *sim = &app->sim;
-    fprintf(f, "// How this run ended (written by mpsflow %s).\n", MPSFLOW_VERSION);
+    /* Stopped before endTime on purpose: stopAt, or a signal. */
+    const bool stopped = status == 0 && app->run.stop_reason[0] &&
+                         sim->time < sim->end_time * (1 - 1e-12);
+    char stop_message[256];
+    if (stopped) {
+        snprintf(stop_message, sizeof stop_message, "%s at time %.10g", app->run.stop_reason,
+                 sim->time);
+        message = stop_message;
+    }
+    fprintf(f, "// How this run ended (written by %s).\n", mf_app_version());
     fprintf(f, "status              %s;\n",
-            status == 0 ? "completed" : (criterion[0] || status == MF_ERR_NUMERIC ? "unstable" : "failed"));
-    fprintf(f, "criterion           %s;\n", criterion[0] ? criterion : (status ? "other" : "none"));
+            stopped       ? "stopped"
+            : status == 0 ? "completed"
+                          : (criterion[0] || status == MF_ERR_NUMERIC ? "unstable" : "failed"));
+    fprintf(f, "criterion           %s;\n",
+            stopped ? (app->run.stop_signal ? "signal" : "stopAt")
+                    : criterion[0] ? criterion : (status ? "other" : "none"));
     fprintf(f, "message             \"");
     for (const char *c = message; *c; c++) /* a dictionary string: escape quotes */
         fprintf(f, "%s%c", (*c == '"' || *c == '\\') ? "\\" : "", *c == '\n' ? ' ' : *c);

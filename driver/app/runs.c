@@ -114,6 +114,8 @@ void mf_read_run_summary(const char *run_dir, mf_run_summary *s)
     if (mf_dict_get_number(d, "steps", &x) == 0) s->steps = (long)x;
     if (mf_dict_get_number(d, "pressureIterations", &x) == 0) s->iterations = (long)x;
     if (mf_dict_get_number(d, "particles", &x) == 0) s->particles = (long)x;
+    if (mf_dict_get_number(d, "time", &x) == 0) s->time = x;
+    if (mf_dict_get_number(d, "endTime", &x) == 0) s->end_time = x;
     mf_error_clear();
     mf_dict_free(d);
 }

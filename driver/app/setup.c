@@ -27,7 +27,7 @@ int mf_app_load_libs_text(mf_registry *reg, const char *text)
     return rc;
 }
 
-static int load_case_libs(mf_app *app)
+int mf_app_load_case_libs(mf_app *app)
 {
     const char **libs = NULL;
     size_t n = 0;
@@ -37,6 +37,19 @@ static int load_case_libs(mf_app *app)
         rc = mf_registry_load_plugin(app->reg, libs[k]);
     free(libs);
     return rc;
+}
+
+int mf_app_load_function_libs(mf_registry *reg, const mf_dict *fd)
+{
+    mf_entry *libs = mf_dict_find(fd, "libs");
+    if (!libs)
+        return 0;
+    libs->used = true;
+    for (size_t i = 0; libs->n == 1 && libs->items[0]->kind == MF_VAL_LIST &&
+                       i < libs->items[0]->n;
+         i++)
+        MF_CALL(mf_registry_load_plugin(reg, libs->items[0]->items[i]->text));
+    return 0;
 }
 
 /* forces { gravity { g (0 -9.81 0); } myDrag { type drag; ... } } */
@@ -152,14 +165,7 @@ static int create_functions(mf_app *app, mf_dict *resolved)
             return MF_ERROR(MF_ERR_INPUT, "%s: function '%s' must be a sub-dictionary { type ...; }",
                             mf_loc_str(e->loc, where, sizeof where), e->key);
         const mf_dict *fd = e->items[0]->dict;
-        mf_entry *libs = mf_dict_find(fd, "libs");
-        if (libs) {
-            libs->used = true;
-            for (size_t i = 0; libs->n == 1 && libs->items[0]->kind == MF_VAL_LIST &&
-                               i < libs->items[0]->n;
-                 i++)
-                MF_CALL(mf_registry_load_plugin(app->reg, libs->items[0]->items[i]->text));
-        }
+        MF_CALL(mf_app_load_function_libs(app->reg, fd));
         const char *type;
         MF_CALL(mf_dict_get_word(fd, "type", &type));
         mf_dict *rf = mf_dict_set_subdict(rfns, e->key);
@@ -197,7 +203,11 @@ int mf_app_setup(mf_app *app)
     sim->reg = app->reg;
     MF_CALL(mf_case_read(app->opt.case_dir, &app->cs));
     MF_CALL(mf_app_create_parallel(app, app->cs.resolved));
-    MF_CALL(load_case_libs(app));
+    /* One rank looks at (and with -overwrite clears) output/: the others
+     * would race it. */
+    MF_CALL(mf_parallel_agree(app->sim.par,
+                              mf_parallel_is_root(app->sim.par) ? mf_app_check_output(app) : 0));
+    MF_CALL(mf_app_load_case_libs(app));
     const mf_control *c = &app->cs.control;
     sim->time = c->start_time;
     sim->end_time = app->opt.end_time > 0 ? app->opt.end_time : c->end_time;
@@ -232,6 +242,10 @@ int mf_app_setup(mf_app *app)
     run->ctl.write_by_steps = strcmp(c->write_control, "timeStep") == 0;
     run->ctl.write_interval = c->write_interval;
     run->ctl.max_retries = c->max_retries;
+    MF_CALL(mf_stop_at_parse(c->stop_at, &run->ctl.stop_at));
+    run->ctl.purge_write = c->purge_write;
+    if (c->run_time_modifiable)
+        MF_CALL(mf_app_watch_control(app));
     run->solver_ops = (const mf_solver_ops *)app->solver.info;
     run->solver = &app->solver;
     run->writer_ops = (const mf_writer_ops *)app->writer.info;
@@ -271,6 +285,7 @@ void mf_app_teardown(mf_app *app)
     free(app->sim.forces);
     free(app->sim.wall_boxes);
     mf_watch_free(&app->run.watch);
+    mf_app_unwatch_control(app);
     mf_emitters_destroy(app->sim.emitters);
     app->sim.emitters = NULL;
     mf_particles_destroy(app->sim.p);
@@ -297,8 +312,6 @@ void mf_app_summary(const mf_app *app)
     for (int k = 0; k < MF_NKINDS; k++)
         if (total[k])
             printf("    %-8s %lld\n", mf_particle_kind_name(k), (long long)total[k]);
-    if (sim->par)
-        printf("nProcs: %d\n", mf_parallel_size(sim->par));
     printf("Fluids:\n");
     for (int k = 0; k < sim->nfluids; k++)
         printf("    %-12s rho = %g kg/m^3, nu = %g m^2/s, sigma = %g N/m\n", sim->fluid[k].name,

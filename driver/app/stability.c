@@ -159,8 +159,9 @@ static void draw_map(const char *case_dir, const char *sweep, const mf_value *sc
     }
 }
 
-int mf_cmd_stability(const char *case_dir, const char *solvers, const char *only)
+int mf_cmd_stability(const mf_options *o)
 {
+    const char *case_dir = o->case_dir, *solvers = o->solvers, *only = o->sweeps;
     if (!solvers)
         return MF_ERROR(MF_ERR_INPUT, "stability needs -solvers '(A B ...)', e.g. mpsflow "
                         "stability -case tutorials/damBreak2D -solvers '(MPS MPS_plain)'");
@@ -176,6 +177,10 @@ int mf_cmd_stability(const char *case_dir, const char *solvers, const char *only
     double end_time = 0;
     if (rc == 0)
         rc = mf_dict_get_number_or(sd, "endTime", 0, &end_time);
+    if (o->end_time > 0) /* -endTime overrides stabilityDict's */
+        end_time = o->end_time;
+    char l0_text[64];
+    snprintf(l0_text, sizeof l0_text, "%.10g", o->l0);
     if (rc == 0 && !sweeps)
         rc = MF_ERROR(MF_ERR_INPUT, "%s: no 'sweeps { ... }' dictionary", path);
     FILE *csv = NULL;
@@ -237,8 +242,17 @@ int mf_cmd_stability(const char *case_dir, const char *solvers, const char *only
                     break;
                 snprintf(log_path, sizeof log_path, "%s/log.mpsflow", run_dir);
                 snprintf(end_text, sizeof end_text, "%.10g", end_time);
-                char *argv[] = {NULL, "-case", run_dir, "-quiet", end_time > 0 ? "-endTime" : NULL,
-                                end_text, NULL};
+                char *argv[8] = {NULL, "-case", run_dir, "-quiet"};
+                int na = 4;
+                if (end_time > 0) {
+                    argv[na++] = "-endTime";
+                    argv[na++] = end_text;
+                }
+                if (o->l0 > 0) {
+                    argv[na++] = "-l0";
+                    argv[na++] = l0_text;
+                }
+                argv[na] = NULL;
                 mf_child_result child;
                 printf("stability: %s = %g, %s ... ", e->key, c->value, scheme);
                 rc = mf_run_child(argv, log_path, &child);

@@ -111,52 +111,6 @@ static int parse(int argc, char **argv, int first, surface_opts *o)
     return 0;
 }
 
-static int parse_time(const char *text, double *out)
-{
-    char *end;
-    errno = 0;
-    *out = strtod(text, &end);
-    if (end == text || errno || !isfinite(*out))
-        return MF_ERROR(MF_ERR_INPUT, "-time: '%s' is not a time", text);
-    return 0;
-}
-
-/* Mark the snapshots (times t[0..n)) that the -time text selects. */
-static int select_times(const char *spec, const double *t, size_t n, bool *sel)
-{
-    char buf[1024];
-    snprintf(buf, sizeof buf, "%s", spec);
-    for (char *save = NULL, *item = strtok_r(buf, ",", &save); item;
-         item = strtok_r(NULL, ",", &save)) {
-        char *colon = strchr(item, ':');
-        if (colon) {
-            double lo = -INFINITY, hi = INFINITY;
-            *colon = '\0';
-            if (*item)
-                MF_CALL(parse_time(item, &lo));
-            if (colon[1])
-                MF_CALL(parse_time(colon + 1, &hi));
-            double tol = 1e-9 * fmax(1.0, fmax(fabs(isfinite(lo) ? lo : 0), fabs(isfinite(hi) ? hi : 0)));
-            bool any = false;
-            for (size_t k = 0; k < n; k++)
-                if (t[k] >= lo - tol && t[k] <= hi + tol)
-                    sel[k] = any = true;
-            if (!any)
-                return MF_ERROR(MF_ERR_INPUT, "-time %s:%s: no snapshot in that range", item,
-                                colon + 1);
-        } else {
-            double v;
-            MF_CALL(parse_time(item, &v));
-            size_t best = 0;
-            for (size_t k = 1; k < n; k++)
-                if (fabs(t[k] - v) < fabs(t[best] - v))
-                    best = k;
-            sel[best] = true;
-        }
-    }
-    return 0;
-}
-
 static int write_resolved(const char *dir, const mf_dict *resolved)
 {
     char path[4500], tmp[4510];
@@ -206,24 +160,14 @@ static int run_surface(const surface_opts *o, mf_registry *reg, mf_log *log)
     if (rc == 0)
         rc = surface_open(reg, dict, o->method, extra, resolved, &s, &m);
     if (rc == 0)
-        rc = mf_list_snapshots(cd, &idx, &n);
-    if (rc == 0) {
-        times = calloc(n, sizeof *times);
-        sel = calloc(n, sizeof *sel);
-        if (!times || !sel)
-            rc = MF_ERROR(MF_ERR_MEMORY, "out of memory");
-    }
-    for (size_t k = 0; k < n && rc == 0; k++) {
-        mf_hdf5_header h;
-        mf_snapshot_path(cd, idx[k], path, sizeof path);
-        rc = mf_hdf5_read_header(path, &h);
-        times[k] = h.time;
-    }
+        rc = mf_snapshot_times(cd, &idx, &times, &n);
+    if (rc == 0 && !(sel = calloc(n, sizeof *sel)))
+        rc = MF_ERROR(MF_ERR_MEMORY, "out of memory");
     if (rc == 0) {
         if (o->latest)
             sel[n - 1] = true;
         else if (o->time)
-            rc = select_times(o->time, times, n, sel);
+            rc = mf_select_times(o->time, times, n, sel);
         else
             for (size_t k = 0; k < n; k++)
                 sel[k] = true;
@@ -246,7 +190,7 @@ static int run_surface(const surface_opts *o, mf_registry *reg, mf_log *log)
     if (rc == 0 && rank == 0)
         rc = write_resolved(out_dir, resolved);
     const mf_surface_ops *ops = rc == 0 ? (const mf_surface_ops *)m.info : NULL;
-    int frames = 0;
+    int frames = 0, skipped = 0;
     double t_all = mf_wall_seconds();
     for (size_t k = 0, kth = 0; k < n && rc == 0; k++) {
         if (!sel[k])
@@ -260,6 +204,17 @@ static int run_surface(const surface_opts *o, mf_registry *reg, mf_log *log)
         sim.reg = reg;
         double t0 = mf_wall_seconds();
         rc = mf_hdf5_read_snapshot(path, &sim);
+        size_t counts[MF_NKINDS] = {0};
+        if (rc == 0)
+            mf_particles_count_kinds(sim.p, counts);
+        if (rc == 0 && counts[MF_FLUID] == 0) {
+            /* A scene that fills over time starts empty: nothing to mesh yet. */
+            mf_log_printf(log, MF_LOG_QUIET, "surface: time %g (%s): no fluid yet, skipped\n",
+                          sim.time, path);
+            skipped++;
+            mf_particles_destroy(sim.p);
+            continue;
+        }
         if (rc == 0) {
             mf_log_printf(log, MF_LOG_NORMAL, "\nTime = %g  (%s)\n", sim.time, path);
             rc = ops->reconstruct(m.data, &sim, &mesh);
@@ -291,9 +246,9 @@ static int run_surface(const surface_opts *o, mf_registry *reg, mf_log *log)
     }
     if (rc == 0)
         mf_log_printf(log, MF_LOG_QUIET,
-                      "\nsurface (%s): %d frames in %.2f s%s, peak memory %.1f MB; ParaView: "
-                      "open %s/surface.xdmf\nEnd\n",
-                      s.method, frames, mf_wall_seconds() - t_all,
+                      "\nsurface (%s): %d frames (%d snapshot(s) without fluid skipped) in "
+                      "%.2f s%s, peak memory %.1f MB; ParaView: open %s/surface.xdmf\nEnd\n",
+                      s.method, frames, skipped, mf_wall_seconds() - t_all,
                       nranks > 1 ? " (spread over the ranks)" : "",
                       mf_peak_memory() / 1048576.0, out_dir);
     surface_close(&m);

@@ -150,14 +150,14 @@ static void table_free(table *t)
         free(t->col[c]);
 }
 
-static int write_report(const char *case_dir, const char *comment, const char *header,
+static int write_report(const char *out_dir, const char *comment, const char *header,
                         const table *t, const mf_plot *plot, const mf_series *series,
                         size_t nseries)
 {
     char path[4400];
-    snprintf(path, sizeof path, "%s/validation/result.csv", case_dir);
+    snprintf(path, sizeof path, "%s/result.csv", out_dir);
     MF_CALL(mf_report_csv(path, comment, header, t->ncols, (const double *const *)t->col, t->n));
-    snprintf(path, sizeof path, "%s/validation/result.png", case_dir);
+    snprintf(path, sizeof path, "%s/result.png", out_dir);
     MF_CALL(mf_report_plot(path, plot, series, nseries));
     return 0;
 }
@@ -216,8 +216,9 @@ static double roundness(const snap *s, int fluid, const double c[3], double R)
     return m > 0 ? sqrt(v) / m : 0;
 }
 
-static int laplace_evaluate(const char *case_dir, const mf_dict *md, double *error)
+static int laplace_evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
 {
+    const char *case_dir = ctx->case_dir;
     laplace_settings s;
     MF_CALL(mf_params_apply(laplace_params, 8, md, metric_extra, &s, NULL));
     double R = s.radius > 0 ? s.radius : s.side / sqrt(M_PI);
@@ -229,7 +230,7 @@ static int laplace_evaluate(const char *case_dir, const mf_dict *md, double *err
         MF_CALL(fluid_index(case_dir, s.drop, &drop));
     int *idx = NULL;
     size_t nsnap = 0;
-    MF_CALL(mf_list_snapshots(case_dir, &idx, &nsnap));
+    MF_CALL(mf_metric_snapshots(ctx, &idx, &nsnap));
     double rho[MF_MAX_FLUIDS] = {0};
     MF_CALL(fluid_densities(case_dir, rho));
     table t = {.ncols = 6};
@@ -323,7 +324,7 @@ static int laplace_evaluate(const char *case_dir, const mf_dict *md, double *err
                                {"force across the interface", t.col[0], t.col[5], t.n, "lines",
                                 NULL},
                                {"Laplace", tx, ty, 2, "lines lw 2", NULL}};
-        rc = write_report(case_dir, comment, "t,dp,p_in,p_out,roundness,dp_force", &t, &plot,
+        rc = write_report(ctx->out_dir, comment, "t,dp,p_in,p_out,roundness,dp_force", &t, &plot,
                           series, 3);
     }
     table_free(&t);
@@ -378,8 +379,9 @@ static double crossing_period(const double *t, const double *q, size_t n, double
     return *nc >= 2 ? 2 * (cross[*nc - 1] - cross[0]) / (double)(*nc - 1) : NAN;
 }
 
-static int osc_evaluate(const char *case_dir, const mf_dict *md, double *error)
+static int osc_evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
 {
+    const char *case_dir = ctx->case_dir;
     osc_settings s;
     MF_CALL(mf_params_apply(osc_params, 6, md, metric_extra, &s, NULL));
     int drop = -1;
@@ -387,7 +389,7 @@ static int osc_evaluate(const char *case_dir, const mf_dict *md, double *error)
         MF_CALL(fluid_index(case_dir, s.drop, &drop));
     int *idx = NULL;
     size_t nsnap = 0;
-    MF_CALL(mf_list_snapshots(case_dir, &idx, &nsnap));
+    MF_CALL(mf_metric_snapshots(ctx, &idx, &nsnap));
     table t = {.ncols = 4};
     int rc = 0, dim = 2;
     for (size_t k = 0; rc == 0 && k < nsnap; k++) {
@@ -459,7 +461,7 @@ static int osc_evaluate(const char *case_dir, const mf_dict *md, double *error)
         snprintf(title, sizeof title, "Droplet oscillation (period error %.3g)", *error);
         mf_plot plot = {title, "t, s", "Q, m^2", false, false, NULL};
         mf_series series[1] = {{"mpsflow", t.col[0], t.col[1], t.n, "linespoints", NULL}};
-        rc = write_report(case_dir, comment, "t,Q,x_extent,y_extent", &t, &plot, series, 1);
+        rc = write_report(ctx->out_dir, comment, "t,Q,x_extent,y_extent", &t, &plot, series, 1);
     }
     free(dext);
     free(cross);
@@ -493,8 +495,9 @@ static const mf_param layer_params[] = {
      "average over the snapshots after this time, s"},
 };
 
-static int layer_evaluate(const char *case_dir, const mf_dict *md, double *error)
+static int layer_evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
 {
+    const char *case_dir = ctx->case_dir;
     layer_settings s;
     MF_CALL(mf_params_apply(layer_params, 6, md, metric_extra, &s, NULL));
     int heavy = 0, light = 0;
@@ -502,7 +505,7 @@ static int layer_evaluate(const char *case_dir, const mf_dict *md, double *error
     MF_CALL(fluid_index(case_dir, s.light, &light));
     int *idx = NULL;
     size_t nsnap = 0;
-    MF_CALL(mf_list_snapshots(case_dir, &idx, &nsnap));
+    MF_CALL(mf_metric_snapshots(ctx, &idx, &nsnap));
     table t = {.ncols = 5};
     int rc = 0;
     double below_sum = 0, h_int = 0, yh_sum = 0, yl_sum = 0;
@@ -568,7 +571,7 @@ static int layer_evaluate(const char *case_dir, const mf_dict *md, double *error
         mf_series series[3] = {{s.heavy, t.col[0], t.col[1], t.n, "linespoints", NULL},
                                {s.light, t.col[0], t.col[2], t.n, "linespoints", NULL},
                                {"interface height", t.col[0], t.col[3], t.n, "lines", NULL}};
-        rc = write_report(case_dir, comment, "t,y_heavy,y_light,h_interface,light_above",
+        rc = write_report(ctx->out_dir, comment, "t,y_heavy,y_light,h_interface,light_above",
                           &t, &plot, series, 3);
     }
     table_free(&t);
@@ -601,8 +604,9 @@ static const mf_param rt_params[] = {
      "g, m/s^2"},
 };
 
-static int rt_evaluate(const char *case_dir, const mf_dict *md, double *error)
+static int rt_evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
 {
+    const char *case_dir = ctx->case_dir;
     rt_settings s;
     MF_CALL(mf_params_apply(rt_params, 6, md, metric_extra, &s, NULL));
     int heavy = 0, light = 0;
@@ -610,7 +614,7 @@ static int rt_evaluate(const char *case_dir, const mf_dict *md, double *error)
     MF_CALL(fluid_index(case_dir, s.light, &light));
     int *idx = NULL;
     size_t nsnap = 0;
-    MF_CALL(mf_list_snapshots(case_dir, &idx, &nsnap));
+    MF_CALL(mf_metric_snapshots(ctx, &idx, &nsnap));
     table t = {.ncols = 4};
     int rc = 0;
     double e0 = 0, e_end = 0, e_min = 0;
@@ -675,7 +679,7 @@ static int rt_evaluate(const char *case_dir, const mf_dict *md, double *error)
             {"spike (heavy, lowest)", t.col[0], t.col[1], t.n, "lines lw 2", NULL},
             {"bubble (light, highest)", t.col[0], t.col[2], t.n, "lines lw 2", NULL},
             {"heavy mean height", t.col[0], t.col[3], t.n, "lines", NULL}};
-        rc = write_report(case_dir, comment, "t,spike,bubble,heavy_mean_height", &t, &plot,
+        rc = write_report(ctx->out_dir, comment, "t,spike,bubble,heavy_mean_height", &t, &plot,
                           series, 3);
     }
     table_free(&t);
@@ -730,8 +734,9 @@ static int fluid_front(const snap *sn, int fluid, double back_wall, double *z)
     return rc;
 }
 
-static int front_evaluate(const char *case_dir, const mf_dict *md, double *error)
+static int front_evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
 {
+    const char *case_dir = ctx->case_dir;
     front_settings s;
     MF_CALL(mf_params_apply(front_params, 7, md, metric_extra, &s, NULL));
     int fluid = 0;
@@ -743,7 +748,7 @@ static int front_evaluate(const char *case_dir, const mf_dict *md, double *error
     MF_CALL(mf_read_csv2(path, &Tref, &Zref, &nref));
     int *idx = NULL;
     size_t nsnap = 0;
-    int rc = mf_list_snapshots(case_dir, &idx, &nsnap);
+    int rc = mf_metric_snapshots(ctx, &idx, &nsnap);
     table t = {.ncols = 2};
     const double tscale = sqrt(2 * s.g / s.a);
     for (size_t k = 0; rc == 0 && k < nsnap; k++) {
@@ -779,7 +784,7 @@ static int front_evaluate(const char *case_dir, const mf_dict *md, double *error
                       case_dir);
     if (rc == 0) {
         *error = sqrt(sum / (double)used);
-        snprintf(path, sizeof path, "%s/validation/result.csv", case_dir);
+        snprintf(path, sizeof path, "%s/result.csv", ctx->out_dir);
         const double *cols[3] = {Tref, Zref, Zsim};
         char comment[512], title[256];
         snprintf(comment, sizeof comment,
@@ -789,7 +794,7 @@ static int front_evaluate(const char *case_dir, const mf_dict *md, double *error
                  s.fluid, s.reference, s.end_wall, used, *error);
         rc = mf_report_csv(path, comment, "T,Z_reference,Z_mpsflow", 3, cols, nref);
         if (rc == 0) {
-            snprintf(path, sizeof path, "%s/validation/result.png", case_dir);
+            snprintf(path, sizeof path, "%s/result.png", ctx->out_dir);
             snprintf(title, sizeof title, "Surge front of %s (RMS error of Z = %.3g)", s.fluid,
                      *error);
             mf_plot plot = {title, "T = t sqrt(2g/a)", "Z = z/a", false, false, NULL};

@@ -35,14 +35,15 @@ static const mf_param hydro_params[] = {
 };
 static const char *const hydro_extra[] = {"FoamFile", NULL};
 
-static int evaluate(const char *case_dir, const mf_dict *md, double *error)
+static int evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
 {
+    const char *case_dir = ctx->case_dir;
     hydro_settings s;
     MF_CALL(mf_params_apply(hydro_params, 6, md, hydro_extra, &s, NULL));
     const double H = s.surface - s.bottom;
     int *idx = NULL;
     size_t nsnap = 0;
-    MF_CALL(mf_list_snapshots(case_dir, &idx, &nsnap));
+    MF_CALL(mf_metric_snapshots(ctx, &idx, &nsnap));
     size_t nbins = 0;
     double *psum = NULL, *count = NULL, l0 = 0;
     int rc = 0, used = 0;
@@ -103,7 +104,7 @@ static int evaluate(const char *case_dir, const mf_dict *md, double *error)
         rc = MF_ERROR(MF_ERR_INPUT, "%s: no interior fluid particle below the surface", case_dir);
     if (rc == 0) {
         *error = sqrt(sum / nb);
-        snprintf(path, sizeof path, "%s/validation/result.csv", case_dir);
+        snprintf(path, sizeof path, "%s/result.csv", ctx->out_dir);
         const double *cols[4] = {y, pavg, pex, rel};
         char comment[512];
         snprintf(comment, sizeof comment,
@@ -114,7 +115,7 @@ static int evaluate(const char *case_dir, const mf_dict *md, double *error)
         rc = mf_report_csv(path, comment, "y,p_mpsflow,p_exact,relative_error", 4, cols, nb);
     }
     if (rc == 0) {
-        snprintf(path, sizeof path, "%s/validation/result.png", case_dir);
+        snprintf(path, sizeof path, "%s/result.png", ctx->out_dir);
         char title[256];
         snprintf(title, sizeof title, "Hydrostatic pressure (RMS relative error %.3g)", *error);
         mf_plot plot = {title, "p, Pa", "y, m", false, false, NULL};

@@ -68,7 +68,7 @@ static int by_y(const void *a, const void *b)
     return (p->y > q->y) - (p->y < q->y);
 }
 
-static int write_report(const char *case_dir, const poiseuille_settings *s, const sample *pts,
+static int write_report(const char *out_dir, const poiseuille_settings *s, const sample *pts,
                         size_t n, double t, double error, double umax)
 {
     double *col[3];
@@ -86,7 +86,7 @@ static int write_report(const char *case_dir, const poiseuille_settings *s, cons
         col[2][i] = pts[i].exact;
     }
     char path[4400], comment[1024];
-    snprintf(path, sizeof path, "%s/validation/result.csv", case_dir);
+    snprintf(path, sizeof path, "%s/result.csv", out_dir);
     snprintf(comment, sizeof comment,
              "Poiseuille start-up: F = %g m/s^2, nu = %g m^2/s, L = %g m, time %g s, %zu fluid "
              "particles\nexact: Morris, Fox & Zhu (1997) eq. 21; centre-line speed %g m/s\n"
@@ -95,7 +95,7 @@ static int write_report(const char *case_dir, const poiseuille_settings *s, cons
     const double *const cols[3] = {col[0], col[1], col[2]};
     int rc = mf_report_csv(path, comment, "y,u,u_exact", 3, cols, n);
     if (rc == 0) {
-        snprintf(path, sizeof path, "%s/validation/result.png", case_dir);
+        snprintf(path, sizeof path, "%s/result.png", out_dir);
         char title[256];
         snprintf(title, sizeof title, "Poiseuille start-up at t = %g s (relative RMS error %.3g)",
                  t, error);
@@ -110,15 +110,16 @@ static int write_report(const char *case_dir, const poiseuille_settings *s, cons
     return rc;
 }
 
-static int evaluate(const char *case_dir, const mf_dict *md, double *error)
+static int evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
 {
+    const char *case_dir = ctx->case_dir;
     poiseuille_settings s;
     MF_CALL(mf_params_apply(poiseuille_params,
                             sizeof poiseuille_params / sizeof poiseuille_params[0], md,
                             poiseuille_extra, &s, NULL));
     int *idx = NULL;
     size_t nsnap = 0;
-    MF_CALL(mf_list_snapshots(case_dir, &idx, &nsnap));
+    MF_CALL(mf_metric_snapshots(ctx, &idx, &nsnap));
     char path[4400];
     mf_snapshot_path(case_dir, idx[nsnap - 1], path, sizeof path);
     free(idx);
@@ -158,7 +159,7 @@ static int evaluate(const char *case_dir, const mf_dict *md, double *error)
     }
     if (rc == 0) {
         qsort(pts, n, sizeof *pts, by_y);
-        rc = write_report(case_dir, &s, pts, n, t, *error, umax);
+        rc = write_report(ctx->out_dir, &s, pts, n, t, *error, umax);
     }
     free(pts);
     mf_particles_destroy(snap.p);

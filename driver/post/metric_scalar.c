@@ -79,7 +79,7 @@ static int by_x(const void *a, const void *b)
     return (p->y > q->y) - (p->y < q->y);
 }
 
-static int write_report(const char *case_dir, const scalar_settings *s, const point *pts,
+static int write_report(const char *out_dir, const scalar_settings *s, const point *pts,
                         size_t n, double t, double error, double worst, double fmin,
                         double fmax)
 {
@@ -99,7 +99,7 @@ static int write_report(const char *case_dir, const scalar_settings *s, const po
         col[3][i] = pts[i].exact;
     }
     char path[4400], comment[1024];
-    snprintf(path, sizeof path, "%s/validation/result.csv", case_dir);
+    snprintf(path, sizeof path, "%s/result.csv", out_dir);
     snprintf(comment, sizeof comment,
              "scalar %s carried by U = (%g %g %g) m/s, time %g s, %zu fluid points\n"
              "exact: the initial profile shifted by U t\n"
@@ -109,7 +109,7 @@ static int write_report(const char *case_dir, const scalar_settings *s, const po
     const double *const cols[4] = {col[0], col[1], col[2], col[3]};
     int rc = mf_report_csv(path, comment, "x,y,f,f_exact", 4, cols, n);
     if (rc == 0) {
-        snprintf(path, sizeof path, "%s/validation/result.png", case_dir);
+        snprintf(path, sizeof path, "%s/result.png", out_dir);
         char title[256], ylabel[96];
         snprintf(title, sizeof title, "%s at t = %g s (RMS error %.3g)", s->field, t, error);
         snprintf(ylabel, sizeof ylabel, "%s", s->field);
@@ -123,14 +123,15 @@ static int write_report(const char *case_dir, const scalar_settings *s, const po
     return rc;
 }
 
-static int evaluate(const char *case_dir, const mf_dict *md, double *error)
+static int evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
 {
+    const char *case_dir = ctx->case_dir;
     scalar_settings s;
     MF_CALL(mf_params_apply(scalar_params, sizeof scalar_params / sizeof scalar_params[0], md,
                             scalar_extra, &s, NULL));
     int *idx = NULL;
     size_t nsnap = 0;
-    MF_CALL(mf_list_snapshots(case_dir, &idx, &nsnap));
+    MF_CALL(mf_metric_snapshots(ctx, &idx, &nsnap));
     char path[4400];
     mf_snapshot_path(case_dir, idx[nsnap - 1], path, sizeof path);
     free(idx);
@@ -172,7 +173,7 @@ static int evaluate(const char *case_dir, const mf_dict *md, double *error)
     if (rc == 0) {
         *error = sqrt(sum / (double)n);
         qsort(pts, n, sizeof *pts, by_x);
-        rc = write_report(case_dir, &s, pts, n, t, *error, worst, fmin, fmax);
+        rc = write_report(ctx->out_dir, &s, pts, n, t, *error, worst, fmin, fmax);
     }
     free(pts);
     mf_particles_destroy(snap.p);
@@ -266,8 +267,9 @@ static double unsteadiness(const mf_particles *a, const mf_particles *b, double 
     return count ? sqrt(sum / (double)count) / speed : NAN;
 }
 
-static int flux_evaluate(const char *case_dir, const mf_dict *md, double *error)
+static int flux_evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
 {
+    const char *case_dir = ctx->case_dir;
     flux_settings s;
     MF_CALL(mf_params_apply(flux_params, sizeof flux_params / sizeof flux_params[0], md,
                             flux_extra, &s, NULL));
@@ -276,7 +278,7 @@ static int flux_evaluate(const char *case_dir, const mf_dict *md, double *error)
     MF_CALL(read_stations(md, &xs, &ns));
     int *idx = NULL;
     size_t nsnap = 0;
-    int rc = mf_list_snapshots(case_dir, &idx, &nsnap);
+    int rc = mf_metric_snapshots(ctx, &idx, &nsnap);
     mf_sim last, before;
     memset(&last, 0, sizeof last);
     memset(&before, 0, sizeof before);
@@ -337,7 +339,7 @@ static int flux_evaluate(const char *case_dir, const mf_dict *md, double *error)
     }
     if (rc == 0) {
         double unsteady = before.p ? unsteadiness(before.p, last.p, s.rate / s.height) : NAN;
-        snprintf(path, sizeof path, "%s/validation/result.csv", case_dir);
+        snprintf(path, sizeof path, "%s/result.csv", ctx->out_dir);
         char comment[1024];
         snprintf(comment, sizeof comment,
                  "flow rate through cross-sections at t = %g s; continuity: Q = Q_in = %g\n"
@@ -352,7 +354,7 @@ static int flux_evaluate(const char *case_dir, const mf_dict *md, double *error)
                reattach, reattach / s.height);
     }
     if (rc == 0) {
-        snprintf(path, sizeof path, "%s/validation/result.png", case_dir);
+        snprintf(path, sizeof path, "%s/result.png", ctx->out_dir);
         char title[256];
         snprintf(title, sizeof title, "Flow rate through cross-sections (RMS error %.3g)", *error);
         mf_plot plot = {title, "x, m", "Q", false, false, NULL};

@@ -73,8 +73,9 @@ static int front_of(const mf_sim *snap, double back_wall, double *z)
     return rc;
 }
 
-static int evaluate(const char *case_dir, const mf_dict *md, double *error)
+static int evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
 {
+    const char *case_dir = ctx->case_dir;
     front_settings s;
     MF_CALL(mf_params_apply(front_params, 5, md, front_extra, &s, NULL));
     char path[4400];
@@ -84,7 +85,7 @@ static int evaluate(const char *case_dir, const mf_dict *md, double *error)
     MF_CALL(mf_read_csv2(path, &Tref, &Zref, &nref));
     int *idx = NULL;
     size_t nsnap = 0;
-    int rc = mf_list_snapshots(case_dir, &idx, &nsnap);
+    int rc = mf_metric_snapshots(ctx, &idx, &nsnap);
     double *T = calloc(nsnap + 1, sizeof *T), *Z = calloc(nsnap + 1, sizeof *Z);
     if (rc == 0 && (!T || !Z))
         rc = MF_ERROR(MF_ERR_MEMORY, "out of memory");
@@ -125,7 +126,7 @@ static int evaluate(const char *case_dir, const mf_dict *md, double *error)
                       case_dir, n ? T[n - 1] : 0.0, Tref[0]);
     if (rc == 0) {
         *error = sqrt(sum / used);
-        snprintf(path, sizeof path, "%s/validation/result.csv", case_dir);
+        snprintf(path, sizeof path, "%s/result.csv", ctx->out_dir);
         const double *cols[3] = {Tref, Zref, Zsim};
         char comment[512];
         snprintf(comment, sizeof comment,
@@ -136,7 +137,7 @@ static int evaluate(const char *case_dir, const mf_dict *md, double *error)
         rc = mf_report_csv(path, comment, "T,Z_reference,Z_mpsflow", 3, cols, nref);
     }
     if (rc == 0) {
-        snprintf(path, sizeof path, "%s/validation/result.png", case_dir);
+        snprintf(path, sizeof path, "%s/result.png", ctx->out_dir);
         char title[256];
         snprintf(title, sizeof title, "Dam break surge front (RMS error of Z = %.3g)", *error);
         mf_plot plot = {title, "T = t sqrt(2g/a)", "Z = z/a", false, false, NULL};

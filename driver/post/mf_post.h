@@ -5,6 +5,7 @@
 #ifndef MF_POST_H
 #define MF_POST_H
 
+#include <stdbool.h>
 #include <stddef.h>
 
 #include "mf_dict.h"
@@ -15,13 +16,37 @@
 int mf_list_snapshots(const char *case_dir, int **indices, size_t *n);
 void mf_snapshot_path(const char *case_dir, int index, char *path, size_t len);
 
-/* A validation metric: reads the case's output, writes
- * validation/result.csv and result.png, returns the error. */
+/* What a metric works on: the case (its validation/ reference data, its
+ * constant/), the snapshots to use (all of output/ for `validate`, the
+ * -time selection for `-postProcess`) and where its report goes
+ * (validation/ for `validate`, postProcessing/<name>/ for -postProcess). */
+typedef struct mf_metric_ctx {
+    const char *case_dir;
+    const int *selected;   /* snapshot indices, ascending; NULL: every snapshot */
+    size_t nselected;
+    const char *out_dir;   /* result.csv and result.png go here */
+} mf_metric_ctx;
+/* The snapshots of ctx (a malloc'ed copy: free *indices). */
+int mf_metric_snapshots(const mf_metric_ctx *ctx, int **indices, size_t *n);
+
+/* A validation metric: reads the snapshots, writes result.csv and
+ * result.png, returns the error. */
 typedef struct mf_metric {
     const char *name;
     const char *summary;
-    int (*evaluate)(const char *case_dir, const mf_dict *metric_dict, double *error);
+    int (*evaluate)(const mf_metric_ctx *ctx, const mf_dict *metric_dict, double *error);
 } mf_metric;
+/* Every metric, and the one named (NULL if none). */
+extern const mf_metric *const mf_metrics[];
+extern const size_t mf_nmetrics;
+const mf_metric *mf_metric_find(const char *name);
+
+/* Snapshots with their times (from the headers), ascending. Free both. */
+int mf_snapshot_times(const char *case_dir, int **indices, double **times, size_t *n);
+/* Mark the snapshots (times t[0..n)) that an OpenFOAM-style -time text
+ * selects: a time (the nearest snapshot), a list "0.1,0.2", a range
+ * "0.1:0.5", ":0.5", "0.5:". */
+int mf_select_times(const char *spec, const double *t, size_t n, bool *sel);
 
 extern const mf_metric mf_metric_surge_front;
 

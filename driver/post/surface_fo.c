@@ -79,6 +79,14 @@ static int fo_write(void *data, const mf_sim *sim)
 {
     surface_fo *d = data;
     const mf_surface_ops *ops = (const mf_surface_ops *)d->m.info;
+    size_t counts[MF_NKINDS];
+    mf_particles_count_kinds(sim->p, counts);
+    if (counts[MF_FLUID] == 0) { /* a scene that fills over time starts empty */
+        mf_log_printf(sim->log, MF_LOG_NORMAL, "surface: time %g: no fluid yet, skipped\n",
+                      sim->time);
+        d->next_index++; /* frames keep the snapshots' numbers */
+        return 0;
+    }
     double t0 = ls_seconds();
     MF_CALL(ops->reconstruct(d->m.data, sim, &d->mesh));
     MF_CALL(mf_mesh_write_frame(d->dir, "surface", d->next_index, &d->mesh, d->s.write_ply,

@@ -13,6 +13,7 @@
 
 static const char *const write_controls[] = {"adjustableRunTime", "timeStep", NULL};
 static const char *const start_froms[] = {"startTime", "latestTime", NULL};
+static const char *const stop_ats[] = {"endTime", "writeNow", "noWriteNow", "nextWrite", NULL};
 
 const mf_param mf_control_params[] = {
     {"application", MF_PARAM_WORD, "mpsflow", MF_NO_RANGE, NULL, offsetof(mf_control, application),
@@ -43,6 +44,16 @@ const mf_param mf_control_params[] = {
      offsetof(mf_control, start_from), "latestTime restarts from the newest snapshot"},
     {"maxRetries", MF_PARAM_INT, "4", 0, 20, NULL, offsetof(mf_control, max_retries),
      "retries of a failed step, each with half the time step"},
+    /* ---- run control (issue 15; core/run/run_control.c) ---------------- */
+    {"stopAt", MF_PARAM_WORD, "endTime", MF_NO_RANGE, stop_ats, offsetof(mf_control, stop_at),
+     "endTime; writeNow / noWriteNow: stop after the current step with / without a snapshot; "
+     "nextWrite: after the next snapshot"},
+    {"runTimeModifiable", MF_PARAM_BOOL, "no", MF_NO_RANGE, NULL,
+     offsetof(mf_control, run_time_modifiable),
+     "re-read this file between steps when it changes (endTime, stopAt, writeInterval, "
+     "time-step limits, purgeWrite)"},
+    {"purgeWrite", MF_PARAM_INT, "0", 0, 1000000000, NULL, offsetof(mf_control, purge_write),
+     "keep only the newest N snapshots of this run, besides the initial one (0: keep all)"},
 };
 const size_t mf_control_nparams = sizeof mf_control_params / sizeof mf_control_params[0];
 
@@ -55,6 +66,21 @@ static int read_one(const char *dir, const char *rel, mf_dict **out)
         return MF_ERROR(MF_ERR_INPUT, "%s: cannot open (%s); is '%s' a case directory?", path,
                         strerror(errno), dir);
     MF_CALL(mf_dict_parse_file(path, out));
+    return 0;
+}
+
+/* controlDict's keys into *c (resolved may be NULL). */
+static int apply_control(const mf_dict *d, mf_control *c, mf_dict *resolved)
+{
+    static const char *const extra[] = {"FoamFile", "libs", "functions", "watch", "writerCoeffs",
+                                        NULL};
+    MF_CALL(mf_params_apply(mf_control_params, mf_control_nparams, d, extra, c, resolved));
+    if (c->end_time <= c->start_time) {
+        char where[512];
+        const mf_entry *e = mf_dict_find(d, "endTime");
+        return MF_ERROR(MF_ERR_INPUT, "%s: endTime (%g) must be after startTime (%g)",
+                        mf_loc_str(e->loc, where, sizeof where), c->end_time, c->start_time);
+    }
     return 0;
 }
 
@@ -71,17 +97,23 @@ int mf_case_read(const char *dir, mf_case *c)
     c->resolved = mf_dict_new("", NULL);
     if (!c->resolved)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory");
-    static const char *const extra[] = {"FoamFile", "libs", "functions", "watch", "writerCoeffs",
-                                        NULL};
-    MF_CALL(mf_params_apply(mf_control_params, mf_control_nparams, c->control_dict, extra,
-                            &c->control, mf_dict_set_subdict(c->resolved, "controlDict")));
-    if (c->control.end_time <= c->control.start_time) {
-        char where[512];
-        const mf_entry *e = mf_dict_find(c->control_dict, "endTime");
-        return MF_ERROR(MF_ERR_INPUT, "%s: endTime (%g) must be after startTime (%g)",
-                        mf_loc_str(e->loc, where, sizeof where), c->control.end_time,
-                        c->control.start_time);
+    MF_CALL(apply_control(c->control_dict, &c->control,
+                          mf_dict_set_subdict(c->resolved, "controlDict")));
+    return 0;
+}
+
+int mf_case_reread_control(const char *dir, mf_control *control, mf_dict **tree)
+{
+    mf_dict *d = NULL;
+    MF_CALL(read_one(dir, "system/controlDict", &d));
+    mf_control c;
+    int rc = apply_control(d, &c, NULL);
+    if (rc != 0) {
+        mf_dict_free(d);
+        return mf_error_trace(rc, __FILE__, __LINE__, __func__);
     }
+    *control = c;
+    *tree = d;
     return 0;
 }
 

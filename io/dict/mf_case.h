@@ -29,6 +29,10 @@ typedef struct mf_control {
     const char *writer;  /* writer module name */
     const char *start_from; /* startTime | latestTime */
     long max_retries;    /* retries of a failed step with a smaller dt */
+    /* Run control (issue 15). */
+    const char *stop_at; /* endTime | writeNow | noWriteNow | nextWrite */
+    bool run_time_modifiable;
+    long purge_write;
 } mf_control;
 
 typedef struct mf_case {
@@ -44,6 +48,11 @@ void mf_case_free(mf_case *c);
 /* The words of a `libs ( ... );` entry of controlDict (NULL-terminated,
  * pointing into the tree). */
 int mf_case_libs(const mf_case *c, const char ***libs, size_t *n);
+/* Read DIR/system/controlDict again (runTimeModifiable): *control and
+ * *tree (which its strings point into; free it with mf_dict_free) on
+ * success; on a bad file an error naming file, line and key, and nothing
+ * changed. */
+int mf_case_reread_control(const char *dir, mf_control *control, mf_dict **tree);
 /* Write c->resolved to DIR/output/resolvedParameters (temp + rename). */
 int mf_case_write_resolved(const mf_case *c);
 

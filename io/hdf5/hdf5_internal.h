@@ -45,6 +45,9 @@ hid_t mf_h5_fapl(void);
 /* The shortest of %.15g, %.16g, %.17g that reads back to exactly x ("0.1",
  * not "0.10000000000000001"): readable and lossless. buf >= 32 bytes. */
 const char *mf_h5_format_double(double x, char *buf, size_t len);
+/* Read a string attribute into buf ("" and 0 when absent; <0 on a read
+ * error). */
+int mf_h5_attr_read_string(hid_t obj, const char *name, char *buf, size_t len);
 /* Units of a dataset by name ("m", "m/s", "Pa", ...; "1" when unknown). */
 const char *mf_h5_unit(const char *dataset);
 /* Datasets every particle group has; anything else is an optional field. */
@@ -71,6 +74,7 @@ typedef struct mf_h5_shape {
     int ncomp;
     int rank;
     bool is_int;
+    bool is_unsigned;
     int precision; /* bytes per element */
 } mf_h5_shape;
 int mf_h5_dataset_shape(hid_t dset, mf_h5_shape *s, const char *what);
@@ -96,8 +100,9 @@ int mf_h5_write_dict(hid_t group, const mf_dict *d, const char *what);
 
 typedef struct mf_xdmf_set {
     char name[MF_H5_NAME_MAX];
+    char unit[32];                 /* the dataset's Units attribute ("" if none) */
     int ncomp;
-    bool is_int;
+    bool is_int, is_unsigned;
     int precision;
 } mf_xdmf_set;
 
@@ -106,6 +111,7 @@ typedef struct mf_xdmf_snap {
     int index;
     double time;
     int64_t n[MF_NKINDS];          /* 0: kind absent */
+    bool point_index[MF_NKINDS];   /* the kind has PointIndex (the vertex cells) */
     size_t nsets[MF_NKINDS];
     mf_xdmf_set *sets[MF_NKINDS];  /* datasets of the kind, Coordinates included */
 } mf_xdmf_snap;
@@ -119,6 +125,8 @@ typedef struct mf_xdmf_index {
 int mf_xdmf_describe(const char *output_dir, int index, mf_xdmf_snap *s);
 /* Add (or replace the entry with the same index); takes ownership of s. */
 int mf_xdmf_index_add(mf_xdmf_index *x, mf_xdmf_snap *s);
+/* Drop the entry of snapshot `index` (purgeWrite), if listed. */
+void mf_xdmf_index_remove(mf_xdmf_index *x, int index);
 /* Describe every readable snapshot of the folder (unreadable ones are left
  * out of the index: the reader skips them too). */
 int mf_xdmf_index_scan(mf_xdmf_index *x, const char *output_dir);

@@ -5,9 +5,11 @@
  * a restart (or a second run) never overwrites earlier output; a leftover
  * .tmp of a crashed write is simply overwritten. */
 #include <errno.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "hdf5_internal.h"
 #include "mf_error.h"
@@ -28,6 +30,9 @@ typedef struct hdf5_writer {
     int compression;
     int next_index;       /* index of the next snapshot written */
     mf_xdmf_index xdmf;   /* the readable snapshots of the folder */
+    int *written;         /* indices this writer wrote, oldest first (purgeWrite) */
+    bool root;            /* rank 0 of a -parallel run (or the serial run): writes the index */
+    size_t nwritten, capwritten;
 } hdf5_writer;
 
 static int make_output_dir(const char *dir)
@@ -58,6 +63,7 @@ static int hdf5_create(const void *settings, const char *case_dir, void **data)
     if (!w)
         return MF_ERROR(MF_ERR_MEMORY, "hdf5 writer: out of memory");
     w->compression = (int)s->compression;
+    w->root = true;
     int rc = 0;
     if (strlen(case_dir) >= sizeof w->case_dir) {
         rc = MF_ERROR(MF_ERR_INPUT, "case path too long: %s", case_dir);
@@ -90,7 +96,17 @@ static int hdf5_write(void *data, const mf_sim *sim, const mf_dict *params)
     MF_CALL(mf_h5_snapshot_path(w->output_dir, w->next_index, path, sizeof path));
     MF_CALL(mf_hdf5_write_snapshot(path, sim, params, w->compression));
     int index = w->next_index++;
-    if (!mf_parallel_is_root(sim->par))
+    if (w->nwritten == w->capwritten) {
+        size_t cap = w->capwritten ? 2 * w->capwritten : 64;
+        int *grown = realloc(w->written, cap * sizeof *grown);
+        if (!grown)
+            return MF_ERROR(MF_ERR_MEMORY, "hdf5 writer: out of memory");
+        w->written = grown;
+        w->capwritten = cap;
+    }
+    w->written[w->nwritten++] = index;
+    w->root = mf_parallel_is_root(sim->par);
+    if (!w->root)
         return 0; /* one index file, written by rank 0 */
     mf_xdmf_snap s;
     MF_CALL(mf_xdmf_describe(w->output_dir, index, &s));
@@ -105,6 +121,7 @@ static void hdf5_destroy(void *data)
     if (!w)
         return;
     mf_xdmf_index_free(&w->xdmf);
+    free(w->written);
     free(w);
 }
 
@@ -128,7 +145,55 @@ static int hdf5_read_latest(void *data, mf_sim *sim)
                       "--> mpsflow Warning: the snapshot(s) after snapshot_%06d.h5 up to "
                       "snapshot_%06d.h5 could not be read; restarting from %s\n",
                       index, newest, path);
+    /* A restart goes on with the case's scene: a snapshot of another
+     * spacing or dimension would be read, and blow up steps later. */
+    mf_hdf5_header h;
+    MF_CALL(mf_hdf5_read_header(path, &h));
+    if (sim->dim != 0 && h.dim != sim->dim)
+        return MF_ERROR(MF_ERR_INPUT,
+                        "cannot restart: %s is %d-D, the case (constant/geometry) is %d-D", path,
+                        h.dim, sim->dim);
+    if (sim->l0 > 0 && fabs(h.l0 - sim->l0) > 1e-9 * sim->l0)
+        return MF_ERROR(MF_ERR_INPUT,
+                        "cannot restart: %s has particle spacing l0 = %.10g, this run %.10g "
+                        "(constant/geometry or -l0): restart with -l0 %.10g, or start a new run",
+                        path, h.l0, sim->l0, h.l0);
     MF_CALL(mf_hdf5_read_snapshot(path, sim));
+    return 0;
+}
+
+/* purgeWrite: the snapshots this writer wrote, oldest first, are in
+ * w->written; delete all but the newest `keep` (never snapshot 0, the
+ * initial state), and list what is left. */
+static int hdf5_purge(void *data, long keep)
+{
+    hdf5_writer *w = data;
+    size_t purgeable = 0;
+    for (size_t k = 0; k < w->nwritten; k++)
+        purgeable += w->written[k] != 0;
+    if (keep < 0 || purgeable <= (size_t)keep)
+        return 0;
+    size_t excess = purgeable - (size_t)keep, m = 0;
+    char path[MF_H5_PATH_MAX];
+    for (size_t k = 0; k < w->nwritten; k++) {
+        int index = w->written[k];
+        if (index == 0 || excess == 0) {
+            w->written[m++] = index;
+            continue;
+        }
+        MF_CALL(mf_h5_snapshot_path(w->output_dir, index, path, sizeof path));
+        if (!w->root) { /* rank 0 removes the files of a -parallel run */
+            excess--;
+            continue;
+        }
+        if (unlink(path) != 0 && errno != ENOENT)
+            return MF_ERROR(MF_ERR_IO, "purgeWrite: cannot remove %s (%s)", path, strerror(errno));
+        mf_xdmf_index_remove(&w->xdmf, index);
+        excess--;
+    }
+    w->nwritten = m;
+    if (w->root)
+        MF_CALL(mf_xdmf_index_write(&w->xdmf, w->output_dir));
     return 0;
 }
 
@@ -140,4 +205,5 @@ const mf_writer_ops mf_writer_hdf5 = {
     .write = hdf5_write,
     .destroy = hdf5_destroy,
     .read_latest = hdf5_read_latest,
+    .purge = hdf5_purge,
 };

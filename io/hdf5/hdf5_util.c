@@ -105,6 +105,11 @@ static const struct { const char *name, *unit; } unit_table[] = {
     {"Acceleration", "m/s^2"},
     {"Temperature", "K"},
     {"Vorticity", "1/s"},
+    {"LightPressure", "Pa"},          /* multiFluid: the gas pass of the two-step pressure */
+    {"Curvature", "1/m"},             /* surfaceTension */
+    {"SurfaceTension", "m/s^2"},      /* surfaceTension: its acceleration */
+    {"ConvectionVelocity", "m/s"},    /* MPS-MAFL */
+    {"PointVelocity", "m/s"},         /* MPS-MAFL */
 };
 
 const char *mf_h5_unit(const char *dataset)
@@ -118,7 +123,8 @@ const char *mf_h5_unit(const char *dataset)
 bool mf_h5_is_core_dataset(const char *name)
 {
     return strcmp(name, "Coordinates") == 0 || strcmp(name, "Velocities") == 0 ||
-           strcmp(name, "ParticleIDs") == 0 || strcmp(name, "StorageIndex") == 0;
+           strcmp(name, "ParticleIDs") == 0 || strcmp(name, "StorageIndex") == 0 ||
+           strcmp(name, "PointIndex") == 0 || strcmp(name, "Kind") == 0;
 }
 
 int mf_h5_attr_write(hid_t obj, const char *name, hid_t file_type, hid_t mem_type, size_t n,
@@ -183,6 +189,32 @@ int mf_h5_attr_read(hid_t obj, const char *name, hid_t mem_type, size_t n, void 
     }
     mf_h5_close(&space);
     mf_h5_close(&attr);
+    return rc;
+}
+
+int mf_h5_attr_read_string(hid_t obj, const char *name, char *buf, size_t len)
+{
+    buf[0] = '\0';
+    if (H5Aexists(obj, name) <= 0)
+        return 0;
+    hid_t attr = H5Aopen(obj, name, H5P_DEFAULT);
+    hid_t type = attr < 0 ? H5I_INVALID_HID : H5Aget_type(attr);
+    int rc = 0;
+    if (type < 0 || H5Tget_class(type) != H5T_STRING || H5Tis_variable_str(type) != 0 ||
+        H5Tget_size(type) >= len) {
+        rc = -1; /* not a short fixed-length string: not ours */
+    } else {
+        hid_t mem = H5Tcopy(type);
+        if (mem < 0 || H5Tset_size(mem, len) < 0 || H5Tset_strpad(mem, H5T_STR_NULLTERM) < 0 ||
+            H5Aread(attr, mem, buf) < 0)
+            rc = -1;
+        mf_h5_close(&mem);
+        buf[len - 1] = '\0';
+    }
+    mf_h5_close(&type);
+    mf_h5_close(&attr);
+    if (rc != 0)
+        buf[0] = '\0';
     return rc;
 }
 
@@ -253,6 +285,7 @@ int mf_h5_dataset_shape(hid_t dset, mf_h5_shape *s, const char *what)
             ncomp *= dims[k];
         s->ncomp = ncomp > 1000000 ? -1 : (int)ncomp;
         s->is_int = cls == H5T_INTEGER;
+        s->is_unsigned = cls == H5T_INTEGER && H5Tget_sign(type) == H5T_SGN_NONE;
         s->precision = cls == H5T_INTEGER || cls == H5T_FLOAT ? (int)size : 0;
     }
     mf_h5_close(&type);

@@ -150,6 +150,22 @@ done:
     return rc;
 }
 
+/* For ParaView's Xdmf3 readers (the default for .xdmf), which make no cells
+ * of a Polyvertex topology without connectivity: PointIndex (0..n-1, one
+ * vertex cell per particle) and Kind (the group's kind, so that the
+ * partitioned reader, which merges the groups, can still tell them apart). */
+static int write_viewer_datasets(const snap_writer *w, hid_t g, const char *group_name, int kind)
+{
+    int32_t *index = w->buf;
+    for (size_t k = 0; k < w->count; k++)
+        index[k] = (int32_t)k;
+    MF_CALL(write_dataset(w, g, group_name, "PointIndex", 1, H5T_STD_I32LE, H5T_NATIVE_INT32));
+    uint8_t *kinds = w->buf;
+    memset(kinds, kind, w->count);
+    MF_CALL(write_dataset(w, g, group_name, "Kind", 1, H5T_STD_U8LE, H5T_NATIVE_UINT8));
+    return 0;
+}
+
 static void gather_double(const snap_writer *w, const double *src, int ncomp)
 {
     double *dst = w->buf;
@@ -197,6 +213,7 @@ static int write_kind(snap_writer *w, int kind)
     for (size_t k = 0; k < w->count; k++)
         ids[k] = w->storage0 + (int64_t)w->index[k];
     MF_CALL_GOTO(rc, write_dataset(w, g, group_name, "StorageIndex", 1, H5T_STD_I64LE, H5T_NATIVE_INT64), done);
+    MF_CALL_GOTO(rc, write_viewer_datasets(w, g, group_name, kind), done);
 
     for (int f = 0; f < p->nfields; f++) {
         const mf_field *field = &p->field[f];

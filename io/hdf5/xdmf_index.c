@@ -1,12 +1,18 @@
 /* xdmf_index.c: <output>/particles.xdmf, the file ParaView opens to see all
  * snapshots as one time series.
  *
- * XDMF 2.0 syntax, which both of ParaView's XDMF readers (the legacy one
- * and Xdmf3) read: a Temporal collection of Spatial collections, one per
+ * XDMF 2.0 syntax, which all three of ParaView 5.11's XDMF readers read
+ * (Xdmf3ReaderS, the default for .xdmf; Xdmf3ReaderT; the legacy
+ * XDMFReader): a Temporal collection of Spatial collections, one per
  * snapshot, each holding one Polyvertex grid per particle kind present
- * (named "fluid", "wall", ...). Geometry is XYZ (z = 0 in 2-D); every other
- * dataset of the kind is a node attribute. Paths are relative to the index,
- * so the output folder can be moved or copied as a whole.
+ * (named "fluid", "wall", ...). Geometry is XYZ (z = 0 in 2-D). The
+ * topology's connectivity is the kind's PointIndex dataset: the Xdmf3
+ * readers make no cells without it, and points without cells render as an
+ * empty frame. Every other dataset of the kind is a node attribute, named
+ * with its unit ("Pressure [Pa]"); Kind tells the kinds apart where the
+ * default reader merges the grids into one. Times are written without
+ * rounding noise (mf_timetext.h). Paths are relative to the index, so the
+ * output folder can be moved or copied as a whole.
  *
  * The index is described from the files themselves (what they hold, not
  * what we meant to write), kept in memory by the writer and rewritten after
@@ -18,6 +24,7 @@
 #include "hdf5_internal.h"
 #include "mf_error.h"
 #include "mf_hdf5.h"
+#include "mf_timetext.h"
 
 static void snap_free(mf_xdmf_snap *s)
 {
@@ -49,16 +56,26 @@ static int describe_kind(hid_t g, const char *what, mf_xdmf_snap *s, int kind)
         if (dset < 0)
             continue;
         mf_h5_shape shape;
+        char unit[32];
         rc = mf_h5_dataset_shape(dset, &shape, what);
+        if (mf_h5_attr_read_string(dset, "Units", unit, sizeof unit) != 0)
+            unit[0] = '\0';
         H5Dclose(dset);
         if (rc != 0 || shape.precision == 0 || shape.rank < 1 || shape.rank > 2)
             continue;
         if (strcmp(names[k], "Coordinates") == 0)
             rows = (int64_t)shape.rows;
+        if (strcmp(names[k], "PointIndex") == 0) {
+            /* The vertex cells: used as the topology, not shown as a field. */
+            s->point_index[kind] = shape.rank == 1 && shape.is_int && shape.precision == 4;
+            continue;
+        }
         mf_xdmf_set *set = &sets[nsets++];
         memcpy(set->name, names[k], sizeof set->name);
+        memcpy(set->unit, unit, sizeof set->unit);
         set->ncomp = shape.ncomp;
         set->is_int = shape.is_int;
+        set->is_unsigned = shape.is_unsigned;
         set->precision = shape.precision;
     }
     free(names);
@@ -152,6 +169,17 @@ int mf_xdmf_index_add(mf_xdmf_index *x, mf_xdmf_snap *s)
     return 0;
 }
 
+void mf_xdmf_index_remove(mf_xdmf_index *x, int index)
+{
+    for (size_t k = 0; k < x->n; k++)
+        if (x->snap[k].index == index) {
+            snap_free(&x->snap[k]);
+            memmove(&x->snap[k], &x->snap[k + 1], (x->n - k - 1) * sizeof *x->snap);
+            x->n--;
+            return;
+        }
+}
+
 int mf_xdmf_index_scan(mf_xdmf_index *x, const char *output_dir)
 {
     int *indices;
@@ -206,15 +234,36 @@ static void put_xml(FILE *f, const char *s)
     }
 }
 
+static const char *number_type(const mf_xdmf_set *set)
+{
+    if (!set->is_int)
+        return "Float";
+    if (set->precision == 1)
+        return set->is_unsigned ? "UChar" : "Char";
+    return set->is_unsigned ? "UInt" : "Int";
+}
+
 static void put_data_item(FILE *f, const mf_xdmf_snap *s, int kind, const mf_xdmf_set *set)
 {
     fprintf(f, "          <DataItem Dimensions=\"%lld", (long long)s->n[kind]);
     if (set->ncomp > 1)
         fprintf(f, " %d", set->ncomp);
     fprintf(f, "\" NumberType=\"%s\" Precision=\"%d\" Format=\"HDF\">snapshot_%06d.h5:/PartType%d/",
-            set->is_int ? "Int" : "Float", set->precision, s->index, kind);
+            number_type(set), set->precision, s->index, kind);
     put_xml(f, set->name);
     fputs("</DataItem>\n", f);
+}
+
+/* The name ParaView shows: the dataset's, with its unit where it has one
+ * ("Pressure [Pa]", "Velocities [m/s]"; "NumberDensity", "Flags"). */
+static void put_attribute_name(FILE *f, const mf_xdmf_set *set)
+{
+    put_xml(f, set->name);
+    if (set->unit[0] && strcmp(set->unit, "1") != 0) {
+        fputs(" [", f);
+        put_xml(f, set->unit);
+        fputc(']', f);
+    }
 }
 
 static void put_snapshot(FILE *f, const mf_xdmf_snap *s)
@@ -222,13 +271,23 @@ static void put_snapshot(FILE *f, const mf_xdmf_snap *s)
     fprintf(f, "    <Grid Name=\"snapshot_%06d\" GridType=\"Collection\" CollectionType=\"Spatial\">\n",
             s->index);
     char time[32];
-    fprintf(f, "      <Time Value=\"%s\"/>\n", mf_h5_format_double(s->time, time, sizeof time));
+    fprintf(f, "      <Time Value=\"%s\"/>\n", mf_time_text(s->time, time, sizeof time));
     for (int kind = 0; kind < MF_NKINDS; kind++) {
         if (s->n[kind] <= 0)
             continue;
         fprintf(f, "      <Grid Name=\"%s\" GridType=\"Uniform\">\n", mf_h5_kind_name(kind));
-        fprintf(f, "        <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"%lld\"/>\n",
-                (long long)s->n[kind]);
+        if (s->point_index[kind]) {
+            const long long n = (long long)s->n[kind];
+            fprintf(f, "        <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"%lld\" "
+                       "NodesPerElement=\"1\">\n"
+                       "          <DataItem Dimensions=\"%lld\" NumberType=\"Int\" Precision=\"4\" "
+                       "Format=\"HDF\">snapshot_%06d.h5:/PartType%d/PointIndex</DataItem>\n"
+                       "        </Topology>\n",
+                    n, n, s->index, kind);
+        } else { /* written before PointIndex: the legacy reader still shows it */
+            fprintf(f, "        <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"%lld\"/>\n",
+                    (long long)s->n[kind]);
+        }
         for (size_t k = 0; k < s->nsets[kind]; k++) {
             const mf_xdmf_set *set = &s->sets[kind][k];
             if (strcmp(set->name, "Coordinates") != 0)
@@ -242,7 +301,7 @@ static void put_snapshot(FILE *f, const mf_xdmf_snap *s)
             if (strcmp(set->name, "Coordinates") == 0)
                 continue;
             fputs("        <Attribute Name=\"", f);
-            put_xml(f, set->name);
+            put_attribute_name(f, set);
             fprintf(f, "\" AttributeType=\"%s\" Center=\"Node\">\n", attribute_type(set->ncomp));
             put_data_item(f, s, kind, set);
             fputs("        </Attribute>\n", f);

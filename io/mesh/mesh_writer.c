@@ -2,7 +2,8 @@
  * index of a surface time series (mf_mesh_writer.h).
  *
  * PLY (Turk 1994; the format as Blender's importer reads it): an ASCII
- * header, then little-endian records; vertices as six float32 (position,
+ * header (its comments: the time, and that y is up, the case's axes), then
+ * little-endian records; vertices as six float32 (position,
  * normal), faces as a uchar count (3) and three int32 indices. */
 #include <dirent.h>
 #include <errno.h>
@@ -15,6 +16,7 @@
 
 #include "mf_error.h"
 #include "mf_mesh_writer.h"
+#include "mf_timetext.h"
 
 #define PATH_MAX_LEN 4352
 
@@ -95,7 +97,8 @@ int mf_mesh_write_ply(const char *path, const mf_mesh *m)
         return MF_ERROR(MF_ERR_IO, "%s: cannot open for writing (%s)", tmp, strerror(errno));
     bool ok = fprintf(f,
                       "ply\nformat binary_little_endian 1.0\ncomment mpsflow surface, time "
-                      "%.17g\nelement vertex %zu\nproperty float x\nproperty float y\nproperty "
+                      "%.17g\ncomment axes of the case: y is up (Blender, z up: "
+                      "mpsflowBlenderImport.py turns it)\nelement vertex %zu\nproperty float x\nproperty float y\nproperty "
                       "float z\nproperty float nx\nproperty float ny\nproperty float nz\nelement "
                       "face %zu\nproperty list uchar int vertex_indices\nend_header\n",
                       m->time, m->nverts, m->ntris) > 0;
@@ -440,11 +443,12 @@ int mf_mesh_write_xdmf_index(const char *dir, const char *prefix)
                       "GridType=\"Collection\" CollectionType=\"Temporal\">\n",
                       prefix) > 0;
     for (size_t k = 0; ok && k < u; k++) {
-        char file[256];
+        char file[256], time[32];
         snprintf(file, sizeof file, "%s_%06d.h5", prefix, fr[k].index);
+        mf_time_text(fr[k].time, time, sizeof time);
         ok = fprintf(f,
                      "   <Grid Name=\"%s_%06d\" GridType=\"Uniform\">\n"
-                     "    <Time Value=\"%.17g\"/>\n"
+                     "    <Time Value=\"%s\"/>\n"
                      "    <Topology TopologyType=\"Triangle\" NumberOfElements=\"%lld\">\n"
                      "     <DataItem Dimensions=\"%lld 3\" NumberType=\"Int\" Precision=\"4\" "
                      "Format=\"HDF\">%s:/Triangles</DataItem>\n"
@@ -458,7 +462,7 @@ int mf_mesh_write_xdmf_index(const char *dir, const char *prefix)
                      "Format=\"HDF\">%s:/Normals</DataItem>\n"
                      "    </Attribute>\n"
                      "   </Grid>\n",
-                     prefix, fr[k].index, fr[k].time, fr[k].ntris, fr[k].ntris, file,
+                     prefix, fr[k].index, time, fr[k].ntris, fr[k].ntris, file,
                      fr[k].nverts, file, fr[k].nverts, file) > 0;
     }
     ok = ok && fprintf(f, "  </Grid>\n </Domain>\n</Xdmf>\n") > 0;

@@ -1,0 +1,8 @@
+"""The boxFilling case in ParaView: the fluid (by speed), the box and plate
+meshes and the free surface of the last frame, saved as
+postProcessing/images/paraview_<time>.png. Run: mpsflowParaView pvPicture.py
+(Allrun does, where ParaView is installed); or in ParaView's Python shell,
+with tutorials/scripts on sys.path."""
+import mpsflow_paraview as mp
+
+mp.picture(".", view_dir=(-0.55, -0.6, -1))
