@@ -122,7 +122,7 @@ static double max_fluid_nu(const mf_sim *sim)
 static int diagnose_collapse(const mf_sim *sim, double dt, double floor_dt, const char *limiter)
 {
     const mf_particles *p = sim->p;
-    size_t fastest = 0;
+    size_t fastest = SIZE_MAX;
     double u2max = -1;
     for (size_t i = 0; i < p->n_owned; i++) {
         const double *v = &p->vel[3 * i];
@@ -132,15 +132,17 @@ static int diagnose_collapse(const mf_sim *sim, double dt, double floor_dt, cons
             fastest = i;
         }
     }
-    const double *x = &p->pos[3 * fastest];
+    mf_particle_info f; /* the fastest over all ranks, named on every rank */
+    mf_parallel_argmax(sim->par, &u2max, p, fastest, &f);
+    const double *x = f.x;
     return MF_ERROR(MF_ERR_NUMERIC,
                     "unstable (timeStep): the time step fell to %g s (%s limit), below "
                     "minDeltaT %g s, at "
                     "time %g: particle id %lld at (%g %g %g) moves at %g m/s. A pressure "
                     "spike feeds back through the Courant limit: try relaxation 0.2, the "
                     "collision model, or a fixed deltaT",
-                    dt, limiter, floor_dt, sim->time, (long long)p->id[fastest], x[0], x[1],
-                    x[2], sqrt(u2max));
+                    dt, limiter, floor_dt, sim->time, (long long)f.id, x[0], x[1], x[2],
+                    sqrt(fmax(u2max, 0)));
 }
 
 /* The step the limits allow ("natural"), then shortened to land on the next
@@ -155,7 +157,9 @@ static int choose_dt(mf_run *run, double next_write, double *dt, const char **li
         *limiter = "fixed";
     } else {
         mf_dt_choice ch;
-        mf_dt_choose(sim->l0, mf_max_fluid_speed(sim->p), c->max_co,
+        double umax = mf_max_fluid_speed(sim->p);
+        mf_parallel_max(sim->par, &umax, 1); /* every rank takes the same step */
+        mf_dt_choose(sim->l0, umax, c->max_co,
                      sim->viscosity_implicit ? 0.0 : max_fluid_nu(sim),
                      c->max_di, c->max_delta_t, &ch);
         double natural = ch.dt;
@@ -169,6 +173,7 @@ static int choose_dt(mf_run *run, double next_write, double *dt, const char **li
         if (run->solver_ops->stable_dt) {
             double sdt = INFINITY;
             MF_CALL(run->solver_ops->stable_dt(run->solver->data, sim, &sdt));
+            mf_parallel_min(sim->par, &sdt, 1);
             if (sdt < natural) {
                 natural = sdt;
                 *limiter = "solver";
@@ -197,12 +202,16 @@ static int write_now(mf_run *run)
 {
     if (!run->writer_ops)
         return 0;
-    MF_CALL(run->writer_ops->write(run->writer->data, run->sim, run->params));
-    for (size_t k = 0; k < run->nfunctions; k++) {
+    /* Collective, and rank 0 alone writes the index: agree on the outcome. */
+    MF_CALL(mf_parallel_agree(run->sim->par,
+                              run->writer_ops->write(run->writer->data, run->sim, run->params)));
+    int rc = 0;
+    for (size_t k = 0; k < run->nfunctions && rc == 0; k++) {
         const mf_function_object_ops *fo = (const mf_function_object_ops *)run->functions[k].info;
         if (fo->write)
-            MF_CALL(fo->write(run->functions[k].data, run->sim));
+            rc = fo->write(run->functions[k].data, run->sim);
     }
+    MF_CALL(mf_parallel_agree(run->sim->par, rc));
     run->writes++;
     MF_CALL(mf_run_after_write(run));
     return 0;
@@ -220,10 +229,30 @@ static int apply_emitters(mf_run *run, double dt, double *kinetic_in, size_t *ad
     if (!sim->emitters)
         return 0;
     const double before = mf_emitters_fluid_kinetic_energy(sim);
-    MF_CALL(mf_emitters_apply(sim->emitters, sim, dt, added, removed));
-    *kinetic_in = mf_emitters_fluid_kinetic_energy(sim) - before;
+    MF_CALL(mf_parallel_agree(sim->par, mf_emitters_apply(sim->emitters, sim, dt, added, removed)));
+    double sums[3] = {mf_emitters_fluid_kinetic_energy(sim) - before, (double)*added,
+                      (double)*removed};
+    mf_parallel_sum(sim->par, sums, 3); /* over the ranks */
+    *kinetic_in = sums[0];
+    *added = (size_t)sums[1];
+    *removed = (size_t)sums[2];
     mf_log_printf(sim->log, MF_LOG_STEP, "Emitters: added %zu, removed %zu\n", *added, *removed);
     return 0;
+}
+
+/* Courant numbers of the fluid over all ranks (the mean weighted by each
+ * rank's fluid count). */
+static void courant(mf_sim *sim, double dt)
+{
+    mf_courant(sim->p, dt, sim->l0, &sim->courant_mean, &sim->courant_max);
+    if (!sim->par)
+        return;
+    size_t counts[MF_NKINDS];
+    mf_particles_count_kinds(sim->p, counts);
+    double v[2] = {sim->courant_mean * (double)counts[MF_FLUID], (double)counts[MF_FLUID]};
+    mf_parallel_sum(sim->par, v, 2);
+    sim->courant_mean = v[1] > 0 ? v[0] / v[1] : 0.0;
+    mf_parallel_max(sim->par, &sim->courant_max, 1);
 }
 
 static int step_once(mf_run *run, saved_state *saved, double next_write)
@@ -237,7 +266,7 @@ static int step_once(mf_run *run, saved_state *saved, double next_write)
     size_t added = 0, removed = 0;
     for (long attempt = 0;; attempt++) {
         sim->dt = dt;
-        mf_courant(sim->p, dt, sim->l0, &sim->courant_mean, &sim->courant_max);
+        courant(sim, dt);
         mf_log_printf(sim->log, MF_LOG_STEP, "Courant Number mean: %g max: %g\n",
                       sim->courant_mean, sim->courant_max);
         mf_log_printf(sim->log, MF_LOG_STEP, "deltaT = %g\n", dt);
@@ -247,6 +276,8 @@ static int step_once(mf_run *run, saved_state *saved, double next_write)
         run->watch.work = work0 + kinetic_in;
         if (rc == 0)
             rc = run->solver_ops->step(run->solver->data, sim, dt);
+        /* One outcome for every rank: all retry, stop or go on together. */
+        rc = mf_parallel_agree(sim->par, rc);
         if (rc == 0) {
             sim->time = saved->time + dt; /* the watch reports the time reached */
             rc = mf_watch_check(&run->watch, sim, dt);
@@ -282,10 +313,12 @@ static int step_once(mf_run *run, saved_state *saved, double next_write)
     sim->time += dt;
     sim->step++;
     run->steps++;
-    for (size_t k = 0; k < run->nfunctions; k++) {
+    int rc = 0;
+    for (size_t k = 0; k < run->nfunctions && rc == 0; k++) {
         const mf_function_object_ops *fo = (const mf_function_object_ops *)run->functions[k].info;
-        MF_CALL(fo->execute(run->functions[k].data, sim));
+        rc = fo->execute(run->functions[k].data, sim);
     }
+    MF_CALL(mf_parallel_agree(sim->par, rc));
     return 0;
 }
 
