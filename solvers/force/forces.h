@@ -25,6 +25,12 @@ double mf_forces_stable_dt(const mf_sim *sim);
  * accumulated and the free surface is known, gets p[i] (one entry per
  * particle: sigma kappa_i where dirichlet[i] is set, 0 elsewhere). */
 bool mf_forces_claim_surface_pressure(mf_sim *sim);
+
+/* The largest radius within which the case's forces read neighbours (m; 0
+ * for none): the copies of other ranks' particles a solver keeps must reach
+ * it. */
+double mf_forces_radius(const mf_sim *sim);
+double mf_drag_radius(const void *drag_data); /* drag.c */
 void mf_forces_surface_pressure(const mf_sim *sim, const uint8_t *dirichlet, double *p);
 
 #endif

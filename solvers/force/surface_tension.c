@@ -70,6 +70,7 @@
 
 #include "forces.h"
 #include "mf_error.h"
+#include "mf_halo.h"
 #include "mf_kernel.h"
 #include "mf_neighbours.h"
 #include "mf_scene.h"
@@ -377,6 +378,15 @@ static int st_create(const void *settings, mf_sim *sim, void **data)
     return 0;
 }
 
+/* The copies [n_owned, n) of what a pass computed on the owned particles
+ * (other ranks' particles, periodic images), for the next pass, which reads
+ * its neighbours' values: nothing without copies. */
+static int sync(const mf_sim *sim, void *values, size_t size)
+{
+    MF_CALL(mf_halo_update(sim->halo, sim->par, sim->p, values, size));
+    return 0;
+}
+
 /* Neighbours within r_st: the solver's list when it reaches, else our own. */
 static int neighbours(st_data *d, const mf_sim *sim, const mf_nlist **out)
 {
@@ -475,8 +485,7 @@ static void count_neighbours(st_data *d, const mf_particles *p, const int32_t *f
 static double measured_full_count(const st_data *d, const mf_particles *p, const mf_nlist *nl)
 {
     const double thr = d->s.beta * d->n_full, rst = d->r;
-    double sum = 0;
-    size_t count = 0;
+    double sum = 0, count = 0;
     for (size_t i = 0; i < p->n_owned; i++) {
         if (p->kind[i] != MF_FLUID || d->nall[i] < thr)
             continue;
@@ -492,7 +501,34 @@ static double measured_full_count(const st_data *d, const mf_particles *p, const
             count++;
         }
     }
-    return count ? sum / (double)count : d->n_full;
+    return count ? sum / count : d->n_full;
+}
+
+/* The same over every rank. */
+static double global_full_count(const st_data *d, const mf_sim *sim, const mf_nlist *nl)
+{
+    if (!sim->par)
+        return measured_full_count(d, sim->p, nl);
+    const double thr = d->s.beta * d->n_full, rst = d->r;
+    const mf_particles *p = sim->p;
+    double v[2] = {0, 0};
+    for (size_t i = 0; i < p->n_owned; i++) {
+        if (p->kind[i] != MF_FLUID || d->nall[i] < thr)
+            continue;
+        bool deep = true;
+        double r[3];
+        for (size_t k = nl->start[i]; k < nl->start[i + 1] && deep; k++) {
+            size_t j = nl->j[k];
+            deep = !(p->kind[j] == MF_FLUID && d->nall[j] < thr &&
+                     dist(&p->pos[3 * i], &p->pos[3 * j], r) < rst);
+        }
+        if (deep) {
+            v[0] += d->nall[i];
+            v[1]++;
+        }
+    }
+    mf_parallel_sum(sim->par, v, 2);
+    return v[1] ? v[0] / v[1] : d->n_full;
 }
 
 /* The normals averaged over the interface particles within r_st (weight
@@ -703,7 +739,9 @@ static int st_accumulate(void *data, const mf_sim *sim, double *acc)
     const long np = (long)p->n_owned;
     const int32_t *n1 = d->n1;
     count_neighbours(d, p, fid, nl);
-    const double n_full = measured_full_count(d, p, nl);
+    MF_CALL(sync(sim, d->n1, sizeof *d->n1));
+    MF_CALL(sync(sim, d->nall, sizeof *d->nall));
+    const double n_full = global_full_count(d, sim, nl);
     /* Interface particles and their curvature (eqs. 36-39); kappa = NAN
      * off the interface. fdir[3i] = 1 marks a free surface. */
 #pragma omp parallel for schedule(dynamic, 64)
@@ -748,9 +786,15 @@ static int st_accumulate(void *data, const mf_sim *sim, double *acc)
         double full = free_surface ? n_full : (double)d->nall[i];
         d->kappa[i] = d->normal ? 0.0 : curvature(d, n2 / full);
     }
+    MF_CALL(sync(sim, d->nrm, 3 * sizeof *d->nrm));
+    MF_CALL(sync(sim, d->fdir, 3 * sizeof *d->fdir));
+    MF_CALL(sync(sim, d->kappa, sizeof *d->kappa));
     if (d->normal) {
         smooth_normals(d, p, fid, nl);
+        MF_CALL(sync(sim, d->nrm, 3 * sizeof *d->nrm));
+        MF_CALL(sync(sim, d->fdir, 3 * sizeof *d->fdir));
         normal_divergence(d, p, fid, nl);
+        MF_CALL(sync(sim, d->kappa, sizeof *d->kappa));
     }
     /* Smoothing (free surfaces): the mean of kappa over the free-surface
      * particles of the same fluid within r_st, weight 1 - r/r_st. A free
@@ -783,6 +827,7 @@ static int st_accumulate(void *data, const mf_sim *sim, double *acc)
             }
             kout[i] = sk / sw;
         }
+        MF_CALL(sync(sim, kout, sizeof *kout));
         double *t = kin;
         kin = kout;
         kout = t;
@@ -855,6 +900,19 @@ double mf_forces_stable_dt(const mf_sim *sim)
                 dt = lim;
         }
     return dt;
+}
+
+double mf_forces_radius(const mf_sim *sim)
+{
+    double r = 0;
+    for (size_t k = 0; k < sim->nforces; k++)
+        if (sim->forces[k].info == &mf_force_surfaceTension.info && sim->forces[k].data) {
+            const st_data *d = sim->forces[k].data;
+            r = fmax(r, d->r);
+        } else if (sim->forces[k].info == &mf_force_drag.info && sim->forces[k].data) {
+            r = fmax(r, mf_drag_radius(sim->forces[k].data));
+        }
+    return r;
 }
 
 bool mf_forces_claim_surface_pressure(mf_sim *sim)

@@ -55,6 +55,7 @@ static void mafl_destroy_data(mafl_data *d)
         d->conv_ops->destroy(d->conv.data);
     mf_module_release(&d->conv);
     mf_grid_free(&d->grid);
+    mf_halo_destroy(d->halo);
     free(d->pos_l);
     free(d->pos_new);
     free(d->value);
@@ -99,6 +100,12 @@ static int create_data(mafl_data *d, mf_sim *sim, const mf_dict *solver_dict)
             memcpy(d->lattice, &p->pos[3 * i], sizeof d->lattice);
             break;
         }
+    /* On several ranks: the MPS phases' copies carry r^n (the PPE source of
+     * densityReference startOfStep and divergence reads it), and the MAFL
+     * phases have copies of their own. */
+    MF_CALL(mps_halo_add_field(d->mps, d->f_pos_n));
+    if (sim->par)
+        MF_CALL(mf_halo_create(&d->halo));
     /* Inlet and outlet points are computation points that stay in place. */
     if (sim->emitters)
         sim->emitters->fixed_buffers = true;

@@ -28,9 +28,11 @@
  * A serial run without a period has no halo (d->halo is NULL: one test per
  * phase).
  */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "force/forces.h"
 #include "mf_error.h"
 #include "mf_halo.h"
 #include "mps.h"
@@ -79,6 +81,8 @@ int mps_halo_create(mps_data *d, mf_sim *sim)
     const double rmax = largest_radius(d);
     if (periodic)
         MF_CALL(check_period(d, sim, rmax));
+    /* The forces read their neighbours through the same copies. */
+    const double radius = fmax(rmax, mf_forces_radius(sim));
     mps_halo *mh = calloc(1, sizeof *mh);
     if (!mh)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory");
@@ -87,7 +91,7 @@ int mps_halo_create(mps_data *d, mf_sim *sim)
         free(mh);
         return mf_error_trace(rc, __FILE__, __LINE__, __func__);
     }
-    mh->spec.radius = rmax;
+    mh->spec.radius = radius;
     if (periodic) {
         mh->spec.periodic_axis = 0;
         mh->spec.periodic_origin = d->s.periodic_origin;

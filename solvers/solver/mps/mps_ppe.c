@@ -129,6 +129,9 @@ int mps_assemble_ppe(mps_data *d, const mf_sim *sim, double dt)
     const mf_particles *p = sim->p;
     const mf_nlist *nl = d->k_lap.re >= d->nl_max.radius ? &d->nl_max : &d->nl_lap;
     const double *n = mf_particles_fd(p, d->f_number_density);
+    /* Which copies are unknowns: their owners decided (a composing solver
+     * may have changed the owned ones since the surface phase). */
+    MF_CALL(mps_halo_sync(d, sim, d->in_ppe, 1));
     size_t nrows = 0, nnz = 0;
     for (size_t i = 0; i < p->n_owned; i++) {
         d->row[i] = d->in_ppe[i] ? (long)nrows++ : -1;

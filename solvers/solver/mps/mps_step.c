@@ -180,10 +180,8 @@ int mps_surface_phase(mps_data *d, mf_sim *sim)
         if (!d->not_dummy[i])
             n[i] = 0; /* dummies take part only as neighbours */
     }
-    if (d->halo) { /* a copy is what its owner is */
+    if (d->halo) /* a copy is what its owner is (its unknowns: mps_assemble_ppe) */
         MF_CALL(mps_halo_sync(d, sim, d->dirichlet, 1));
-        MF_CALL(mps_halo_sync(d, sim, d->in_ppe, 1));
-    }
     d->t_assembly += mf_wall_seconds() - t0;
     return 0;
 }

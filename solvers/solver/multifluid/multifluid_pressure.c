@@ -109,11 +109,12 @@ static int light_solve(multifluid_data *d, mf_sim *sim, double dt, long k, doubl
             m->in_ppe[i] = d->in_all[i] && !d->heavy_rows[i];
         m->rho = d->rho;
         memcpy(d->p_dirichlet, P, n * sizeof *P); /* the heavy solve's pressure */
+        MF_CALL(mps_halo_sync(m, sim, d->p_dirichlet, sizeof *d->p_dirichlet));
         m->p_dirichlet = d->p_dirichlet;
         memcpy(P, pl, n * sizeof *P);
     }
     MF_CALL(run_solve(m, sim, dt));
-    memcpy(pl, P, n * sizeof *P);
+    memcpy(pl, P, sim->p->n * sizeof *P); /* copies too: the solve synchronised P */
     return 0;
 }
 
@@ -153,7 +154,7 @@ static int rounds(multifluid_data *d, mf_sim *sim, double dt, long *made, double
         if (rows > 0)
             MF_CALL(run_solve(m, sim, dt));
         else
-            memcpy(P, pl, n * sizeof *P);
+            memcpy(P, pl, p->n * sizeof *P); /* copies too: pl's are its owners' */
         memcpy(d->p_prev, P, n * sizeof *P);
         /* 3. the correction each fluid's pressure makes (eq. 15), not applied
          * yet: the round has converged when it moves no particle by more
@@ -203,6 +204,9 @@ int multifluid_iterative_pressure(multifluid_data *d, mf_sim *sim, double dt)
         d->heavy_mask[i] = fluid && d->heavy[fid[i]];
         d->light_mask[i] = fluid && !d->heavy[fid[i]];
     }
+    /* A wall is in the heavy solve when a heavy particle, maybe another
+     * rank's, is near: the copies' masks. */
+    MF_CALL(mps_halo_sync(m, sim, d->heavy_mask, sizeof *d->heavy_mask));
     long made = 0;
     double dr = 0;
     int rc = rounds(d, sim, dt, &made, &dr);

@@ -54,8 +54,8 @@ static int one_fluid_step(multifluid_data *d, mf_sim *sim, double dt)
 {
     mps_data *m = d->mps;
     MF_CALL(mps_reserve(m, sim->p->n));
-    MF_CALL(multifluid_reserve(d, sim->p->n));
     MF_CALL(mps_build_neighbours(m, sim, true));
+    MF_CALL(multifluid_reserve(d, sim->p->n)); /* particles may have come from other ranks */
     mps_set_masks(m, sim->p);
     MF_CALL(mps_explicit_phase(m, sim, dt));
     MF_CALL(mps_build_neighbours(m, sim, false));
@@ -76,10 +76,14 @@ int multifluid_step(multifluid_data *d, mf_sim *sim, double dt)
     }
     mf_particles *p = sim->p;
     MF_CALL(mps_reserve(m, p->n));
+    MF_CALL(mps_build_neighbours(m, sim, true)); /* at r^n; may reorder or migrate particles */
     MF_CALL(multifluid_reserve(d, p->n));
-    MF_CALL(mps_build_neighbours(m, sim, true)); /* at r^n; may reorder the particles */
     mps_set_masks(m, p);
     multifluid_fill_properties(d, sim);
+    /* A wall copy's neighbourhood is cut at the halo's edge: its owner's values. */
+    MF_CALL(mps_halo_sync(m, sim, d->rho, sizeof *d->rho));
+    MF_CALL(mps_halo_sync(m, sim, d->mu, sizeof *d->mu));
+    MF_CALL(mps_halo_sync(m, sim, d->rho_light, sizeof *d->rho_light));
     m->rho = d->rho;
     m->mu = d->mu;
     m->p_dirichlet = NULL;
