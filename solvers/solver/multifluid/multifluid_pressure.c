@@ -129,7 +129,9 @@ static int rounds(multifluid_data *d, mf_sim *sim, double dt, long *made, double
     solve_names(d, sim, name_light, name_heavy, sizeof name_light);
     MF_CALL(mps_surface_phase(m, sim)); /* at r*: number density, free surface */
     memcpy(d->in_all, m->in_ppe, n);
-    size_t rows = set_heavy_unknowns(d, sim); /* fills m->in_ppe */
+    double global_rows = (double)set_heavy_unknowns(d, sim); /* fills m->in_ppe */
+    mf_parallel_sum(sim->par, &global_rows, 1); /* every rank solves, or none */
+    const size_t rows = (size_t)global_rows;
     memcpy(d->heavy_rows, m->in_ppe, n);
     memcpy(d->p_prev, P, n * sizeof *P);
     *made = 0;
@@ -177,6 +179,7 @@ static int rounds(multifluid_data *d, mf_sim *sim, double dt, long *made, double
             if (c2 > change * change)
                 change = sqrt(c2);
         }
+        mf_parallel_max(sim->par, &change, 1); /* one decision for every rank */
         m->t_correction += mf_wall_seconds() - tc;
         double du = change * dt, dr = du * dt / sim->l0;
         *made = k;

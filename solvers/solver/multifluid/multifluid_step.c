@@ -48,6 +48,18 @@ void multifluid_fill_properties(multifluid_data *d, const mf_sim *sim)
     }
 }
 
+/* The copies' densities and viscosities are their owners' (a wall copy's
+ * neighbourhood is cut at the halo's edge, and the copies at r* are not
+ * those at r^n): the owned values persist through the step. */
+static int sync_properties(multifluid_data *d, const mf_sim *sim)
+{
+    const mps_data *m = d->mps;
+    MF_CALL(mps_halo_sync(m, sim, d->rho, sizeof *d->rho));
+    MF_CALL(mps_halo_sync(m, sim, d->mu, sizeof *d->mu));
+    MF_CALL(mps_halo_sync(m, sim, d->rho_light, sizeof *d->rho_light));
+    return 0;
+}
+
 /* One fluid with the Laplace pressure on its free surface: the phases of
  * mps_lagrangian_step, pressure and correction from multifluid_surface.c. */
 static int one_fluid_step(multifluid_data *d, mf_sim *sim, double dt)
@@ -64,7 +76,20 @@ static int one_fluid_step(multifluid_data *d, mf_sim *sim, double dt)
     return 0;
 }
 
+static int step_phases(multifluid_data *d, mf_sim *sim, double dt);
+
+/* The phases, then the copies of other ranks' particles (and images)
+ * dropped, as mps_lagrangian_step does: emitters and the writer see owned
+ * particles only. */
 int multifluid_step(multifluid_data *d, mf_sim *sim, double dt)
+{
+    int rc = step_phases(d, sim, dt);
+    if (d->mps->halo)
+        mps_halo_end(d->mps, sim);
+    return rc;
+}
+
+static int step_phases(multifluid_data *d, mf_sim *sim, double dt)
 {
     mps_data *m = d->mps;
     if (d->f_fluid < 0) { /* one fluid: the MPS step itself */
@@ -80,15 +105,13 @@ int multifluid_step(multifluid_data *d, mf_sim *sim, double dt)
     MF_CALL(multifluid_reserve(d, p->n));
     mps_set_masks(m, p);
     multifluid_fill_properties(d, sim);
-    /* A wall copy's neighbourhood is cut at the halo's edge: its owner's values. */
-    MF_CALL(mps_halo_sync(m, sim, d->rho, sizeof *d->rho));
-    MF_CALL(mps_halo_sync(m, sim, d->mu, sizeof *d->mu));
-    MF_CALL(mps_halo_sync(m, sim, d->rho_light, sizeof *d->rho_light));
+    MF_CALL(sync_properties(d, sim));
     m->rho = d->rho;
     m->mu = d->mu;
     m->p_dirichlet = NULL;
     MF_CALL(mps_explicit_phase(m, sim, dt));      /* eq. 27 */
     MF_CALL(mps_build_neighbours(m, sim, false)); /* at r* */
+    MF_CALL(sync_properties(d, sim)); /* the copies at r* are other particles */
     if (d->iterative) {
         MF_CALL(multifluid_iterative_pressure(d, sim, dt));
         return 0;
