@@ -319,3 +319,64 @@ int mf_parallel_distribute(mf_parallel *par, mf_particles *p, int64_t first_new_
         mf_parallel_imbalance(par, p);
     return 0;
 }
+
+int mf_parallel_gather(mf_parallel *par, const mf_particles *p, int root, mf_particles **out)
+{
+    *out = NULL;
+    if (!par)
+        return MF_ERROR(MF_ERR_INTERNAL, "mf_parallel_gather on a serial run");
+    const size_t row = mf_particles_packed_bytes(p);
+    const size_t n = p->n_owned;
+    size_t *idx = malloc((n + 1) * sizeof *idx);
+    char *send = malloc(n * row + 1), *recv = NULL;
+    int *counts = NULL, *displs = NULL;
+    int rc = idx && send ? 0 : MF_ERROR(MF_ERR_MEMORY, "out of memory gathering particles");
+    long long total = 0;
+    if (rc == 0 && n * row > (size_t)INT32_MAX)
+        rc = MF_ERROR(MF_ERR_INPUT, "%zu particles are too many to gather on one rank", n);
+    MF_CALL_GOTO(rc, mf_parallel_agree(par, rc), done);
+    for (size_t i = 0; i < n; i++)
+        idx[i] = i;
+    mf_particles_pack(p, idx, n, send);
+    int mine = (int)(n * row);
+    if (par->rank == root) {
+        counts = malloc((size_t)par->size * sizeof *counts);
+        displs = malloc((size_t)par->size * sizeof *displs);
+    }
+    MPI_Gather(&mine, 1, MPI_INT, counts, 1, MPI_INT, root, par->comm);
+    if (par->rank == root) {
+        for (int r = 0; r < par->size; r++) {
+            displs[r] = (int)total;
+            total += counts[r];
+        }
+        if (total > INT32_MAX)
+            rc = MF_ERROR(MF_ERR_INPUT, "%lld bytes of particles are too many to gather", total);
+        else if (!(recv = malloc((size_t)total + 1)))
+            rc = MF_ERROR(MF_ERR_MEMORY, "out of memory gathering %lld bytes", total);
+    }
+    MF_CALL_GOTO(rc, mf_parallel_agree(par, rc), done);
+    MPI_Gatherv(send, mine, MPI_BYTE, recv, counts, displs, MPI_BYTE, root, par->comm);
+    if (par->rank == root) {
+        /* A store with the same fields in the same order: the packed rows fit. */
+        mf_particles *q = NULL;
+        rc = mf_particles_create(p->dim, (size_t)(total / (long long)row) + 1, &q);
+        for (int f = 0; rc == 0 && f < p->nfields; f++)
+            rc = mf_particles_request_field(q, p->field[f].name, p->field[f].ncomp,
+                                            p->field[f].type, p->field[f].output, NULL);
+        if (rc == 0)
+            rc = mf_particles_append_packed(q, recv, (size_t)(total / (long long)row));
+        if (rc == 0) {
+            q->next_id = p->next_id;
+            *out = q;
+        } else {
+            mf_particles_destroy(q);
+        }
+    }
+done:
+    free(idx);
+    free(send);
+    free(recv);
+    free(counts);
+    free(displs);
+    return rc;
+}

@@ -140,4 +140,10 @@ double mf_parallel_imbalance(mf_parallel *par, const mf_particles *p);
  * NULL or before the first partition). */
 int mf_parallel_owner_of(const mf_parallel *par, const double x[3]);
 
+/* Every rank's owned particles (every array and field), gathered on rank
+ * `root` into a new store *out (in rank order); NULL on the other ranks.
+ * For the post-processing that needs the whole fluid at once (the surface
+ * function object). Collective. */
+int mf_parallel_gather(mf_parallel *par, const mf_particles *p, int root, mf_particles **out);
+
 #endif

@@ -232,7 +232,7 @@ static int run_case(mf_app *app)
                   "MB\n",
                   app->run.steps, app->run.retries, app->run.writes, app->run.wall_seconds,
                   mf_peak_memory() / 1048576.0);
-    if (mf_parallel_is_root(app->sim.par) && mf_write_run_summary(app, rc) != 0 && rc == 0)
+    if (mf_write_run_summary(app, rc) != 0 && rc == 0)
         return mf_error_trace(MF_ERR_IO, __FILE__, __LINE__, __func__);
     MF_CALL(rc);
     mf_log_printf(&app->log, MF_LOG_QUIET, "End\n");

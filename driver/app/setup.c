@@ -199,6 +199,8 @@ int mf_app_setup(mf_app *app)
     mf_log_init(&app->log, stdout, app->opt.log_level);
     if (mf_parallel_world_rank() != 0)
         app->log.out = NULL; /* rank 0 writes the log */
+    if (mf_parallel_world_size() > 1)
+        app->log.progress = false; /* mpirun hands rank 0 a terminal even into a file */
     sim->log = &app->log;
     sim->reg = app->reg;
     MF_CALL(mf_case_read(app->opt.case_dir, &app->cs));

@@ -148,7 +148,8 @@ static void mafl_destroy(void *data) { mafl_destroy_data(data); }
 static void mafl_report(void *data, const mf_sim *sim, mf_log *log)
 {
     const mafl_data *d = data;
-    (void)sim;
+    double points[2] = {(double)d->total_added, (double)d->total_removed}; /* every rank's */
+    mf_parallel_sum(sim->par, points, 2);
     /* Steps this run took (one explicit phase of the MPS module each);
      * sim->step counts from before a restart. */
     const double steps = d->mps->attempts > 0 ? (double)d->mps->attempts : 1.0;
@@ -159,9 +160,9 @@ static void mafl_report(void *data, const mf_sim *sim, mf_log *log)
                   1e3 * d->t_lagrangian / steps, 1e3 * d->t_reconfigure / steps,
                   1e3 * d->t_eulerian / steps, 1e3 * d->t_points / steps, 1e3 * total / steps);
     mf_log_printf(log, MF_LOG_QUIET,
-                  "MAFL points: added %zu (eq. 22), removed %zu over the run; %ld grid "
-                  "widenings where |u^a| dt > dr\n",
-                  d->total_added, d->total_removed, d->q_limited);
+                  "MAFL points: added %.0f (eq. 22), removed %.0f over the run; %ld grid "
+                  "widenings where |u^a| dt > dr%s\n",
+                  points[0], points[1], d->q_limited, sim->par ? " (on rank 0)" : "");
 }
 
 const mf_solver_ops mf_solver_MAFL = {

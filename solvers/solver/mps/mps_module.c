@@ -166,10 +166,12 @@ static void mps_report(void *data, const mf_sim *sim, mf_log *log)
                   1e3 * d->t_assembly / attempts, 1e3 * d->t_solve / attempts,
                   1e3 * d->t_setup / attempts, 1e3 * d->t_pcg / attempts,
                   1e3 * d->t_correction / attempts, 1e3 * total / attempts);
+    double rows = (double)d->ppe_rows; /* over the ranks */
+    mf_parallel_sum(sim->par, &rows, 1);
     mf_log_printf(log, MF_LOG_QUIET,
-                  "MPS pressure: %ld unknowns in the last solve, %.2f iterations per solve on "
+                  "MPS pressure: %.0f unknowns in the last solve, %.2f iterations per solve on "
                   "average\n",
-                  d->ppe_rows,
+                  rows,
                   (double)sim->pressure_iterations / (d->solves > 0 ? (double)d->solves : 1.0));
     mps_viscosity_report(d->visc, sim, log);
 }
