@@ -118,7 +118,8 @@ void mf_decompose_free(mf_parallel *par)
 
 /* Send the owned particles idx[k] to rank dest[k] (never this rank) and
  * take in those sent here: every rank calls it, with or without movers. */
-static int exchange(mf_parallel *par, mf_particles *p, const size_t *idx, int *dest, size_t n)
+static int exchange(mf_parallel *par, mf_particles *p, const size_t *idx, int *dest, size_t n,
+                    size_t *moved)
 {
     const size_t row = mf_particles_packed_bytes(p);
     if (row > (size_t)INT32_MAX)
@@ -147,7 +148,7 @@ static int exchange(mf_parallel *par, mf_particles *p, const size_t *idx, int *d
     size_t removed = 0;
     MF_CALL_GOTO(rc, mf_particles_remove(p, gone, &removed), done);
     MF_CALL_GOTO(rc, mf_particles_append_packed(p, recv, (size_t)nrecv), done);
-    par->stats.migrated += n;
+    *moved += n;
 done:
     if (plan)
         Zoltan_Comm_Destroy(&plan);
@@ -169,6 +170,21 @@ int mf_parallel_owner_of(const mf_parallel *par, const double x[3])
 }
 
 static int migrate(mf_parallel *par, mf_particles *p, bool all_kinds);
+
+void mf_parallel_set_margin(mf_parallel *par, double margin)
+{
+    if (par)
+        par->margin = margin > 0 ? margin : 0;
+}
+
+/* x inside this rank's box grown by the margin. */
+static bool in_box(const mf_parallel *par, const double *x, int dim)
+{
+    for (int c = 0; c < dim; c++)
+        if (x[c] < par->box[c] - par->margin || x[c] > par->box[3 + c] + par->margin)
+            return false;
+    return true;
+}
 
 /* Zoltan's partition of the owned particles, then the exports sent. */
 static int partition(mf_parallel *par, mf_particles *p)
@@ -195,13 +211,19 @@ static int partition(mf_parallel *par, mf_particles *p)
     }
     rc = mf_parallel_agree(par, rc);
     if (rc == 0)
-        rc = exchange(par, p, idx, exp_proc, (size_t)(nexp > 0 ? nexp : 0));
+        rc = exchange(par, p, idx, exp_proc, (size_t)(nexp > 0 ? nexp : 0),
+                      &par->stats.repartitioned);
     free(idx);
     Zoltan_LB_Free_Part(&imp_gid, &imp_lid, &imp_proc, &imp_part);
     Zoltan_LB_Free_Part(&exp_gid, &exp_lid, &exp_proc, &exp_part);
     par->zp = NULL;
     MF_CALL(rc);
     par->partitioned = true;
+    double *b = par->box;
+    int ndim = 0;
+    par->has_box = par->s.method == MF_DECOMPOSE_RCB &&
+                   Zoltan_RCB_Box(par->zz, par->rank, &ndim, &b[0], &b[1], &b[2], &b[3], &b[4],
+                                  &b[5]) == ZOLTAN_OK;
     /* Zoltan may split particles that sit exactly on a cut (a lattice row)
      * between both sides; Zoltan_LB_Point_Assign, which later migrations
      * ask, puts them on one. Follow it now, so that ownership is always
@@ -225,6 +247,8 @@ static int migrate(mf_parallel *par, mf_particles *p, bool all_kinds)
     for (size_t i = 0; i < p->n_owned && rc == 0; i++) {
         if (!all_kinds && (p->kind[i] == MF_WALL || p->kind[i] == MF_DUMMY))
             continue;
+        if (par->has_box && par->margin > 0 && in_box(par, &p->pos[3 * i], p->dim))
+            continue;
         const int owner = mf_parallel_owner_of(par, &p->pos[3 * i]);
         if (owner == par->rank)
             continue;
@@ -246,7 +270,8 @@ static int migrate(mf_parallel *par, mf_particles *p, bool all_kinds)
     }
     rc = mf_parallel_agree(par, rc);
     if (rc == 0)
-        rc = exchange(par, p, idx, dest, n);
+        rc = exchange(par, p, idx, dest, n,
+                      all_kinds ? &par->stats.repartitioned : &par->stats.migrated);
     free(idx);
     free(dest);
     MF_CALL(rc);

@@ -354,7 +354,10 @@ int mf_halo_build(mf_halo *h, mf_parallel *par, mf_particles *p, const mf_halo_s
     MF_CALL_GOTO(rc, mf_parallel_agree(par, rc), done);
     double mine[6];
     owned_box(p, mine);
+    const double t_wait = par ? MPI_Wtime() : 0;
     mf_parallel_allgather(par, mine, sizeof mine, boxes);
+    if (par)
+        par->stats.t_halo_wait += MPI_Wtime() - t_wait;
     rc = plan_copies(h, par, p, boxes);
     MF_CALL_GOTO(rc, mf_parallel_agree(par, rc), done);
 

@@ -57,10 +57,13 @@ void mf_parallel_default_settings(mf_parallel_settings *s);
  * (this rank's share; sums and maxima over ranks are the caller's). */
 typedef struct mf_parallel_stats {
     long migrations, rebalances;
-    size_t migrated;        /* particles this rank sent away by migration */
+    size_t migrated;        /* particles this rank sent away by migration (between partitions) */
+    size_t repartitioned;   /* particles this rank sent away with new partitions */
     double imbalance;       /* heaviest load / mean load at the last check */
     double imbalance_before; /* the same before the last new partition */
     double t_migrate, t_rebalance, t_halo; /* wall seconds */
+    double t_halo_wait;     /* of t_halo: in the first collective call of a build,
+                               where a rank waits for the slowest (load imbalance) */
     long halo_builds, halo_updates;
     size_t halo_particles;  /* copies received, summed over builds */
     size_t halo_sent_bytes; /* bytes sent by halo builds and updates */
@@ -136,6 +139,11 @@ int mf_parallel_balance(mf_parallel *par, mf_particles *p, bool force);
 /* Weighted load of this rank's owned particles, and the imbalance (heaviest
  * rank over the mean; 1 when par is NULL). Collective. */
 double mf_parallel_imbalance(mf_parallel *par, const mf_particles *p);
+/* Hysteresis of migration (RCB): a particle within this distance outside
+ * its rank's box stays there, so that a lattice row lying on a cut does not
+ * cross it back and forth with every rounding of its positions (0: none,
+ * the default). The halos do not depend on it. */
+void mf_parallel_set_margin(mf_parallel *par, double margin);
 /* The rank whose region holds x under the current partition (0 when par is
  * NULL or before the first partition). */
 int mf_parallel_owner_of(const mf_parallel *par, const double x[3]);

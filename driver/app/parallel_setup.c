@@ -127,6 +127,8 @@ int mf_app_distribute(mf_app *app)
     mf_sim *sim = &app->sim;
     if (!sim->par)
         return 0;
+    /* A quarter spacing of hysteresis: lattice rows on a cut stay put. */
+    mf_parallel_set_margin(sim->par, 0.25 * sim->l0);
     MF_CALL(mf_parallel_distribute(sim->par, sim->p, sim->p->next_id));
     double c[2] = {(double)sim->p->n_owned, (double)sim->p->n_owned};
     mf_parallel_min(sim->par, &c[0], 1);
@@ -147,7 +149,7 @@ void mf_app_report_parallel(const mf_app *app)
         return;
     const mf_parallel_stats *st = mf_parallel_statistics(par);
     const double steps = app->run.steps > 0 ? (double)app->run.steps : 1.0;
-    enum { NV = 8 };
+    enum { NV = 9 };
     const double mine[NV] = {
         (double)app->sim.p->n_owned,
         st->owned_at_builds ? (double)st->halo_particles / (double)st->owned_at_builds : 0.0,
@@ -157,6 +159,7 @@ void mf_app_report_parallel(const mf_app *app)
         st->t_migrate / steps,
         st->t_rebalance,
         (double)st->rebalances,
+        st->t_halo_wait / steps,
     };
     const int size = mf_parallel_size(par);
     double *all = malloc((size_t)size * NV * sizeof *all);
@@ -167,14 +170,15 @@ void mf_app_report_parallel(const mf_app *app)
         mf_log *log = (mf_log *)&app->log;
         mf_log_printf(log, MF_LOG_QUIET,
                       "\nParallel: %d ranks, %ld new partitions, load imbalance %.3f at the end\n"
-                      "    rank   owned  halo/owned  halo kB/step  migrated/step  halo ms/step  "
-                      "migrate ms/step  rebalance s\n",
+                      "    rank   owned  halo/owned  halo kB/step  migrated/step  halo ms/step "
+                      "(waiting)  migrate ms/step  rebalance s\n",
                       size, st->rebalances, st->imbalance);
         for (int r = 0; r < size && size <= 16; r++) {
             const double *v = all + (size_t)r * NV;
             mf_log_printf(log, MF_LOG_QUIET,
-                          "    %4d %7.0f %11.3f %13.1f %14.1f %13.2f %16.2f %12.2f\n", r, v[0],
-                          v[1], v[2] / 1024, v[3], 1e3 * v[4], 1e3 * v[5], v[6]);
+                          "    %4d %7.0f %11.3f %13.1f %14.1f %13.2f (%7.2f) %16.2f %12.2f\n",
+                          r, v[0], v[1], v[2] / 1024, v[3], 1e3 * v[4], 1e3 * v[8],
+                          1e3 * v[5], v[6]);
         }
         if (size > 16)
             for (int k = 0; k < NV; k++) {
