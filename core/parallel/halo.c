@@ -49,7 +49,12 @@ struct mf_halo {
     size_t cap_sbuf, cap_rbuf;
     candidate *cand;
     size_t cap_cand;
+    size_t elem_cap; /* the buffers hold this many bytes a copy (the same on every rank) */
 };
+
+/* Updates of values up to this size (9 doubles: any particle field) find
+ * their buffers ready, so they need no agreement between the ranks. */
+#define UPDATE_BYTES (9 * sizeof(double))
 
 int mf_halo_create(mf_halo **out)
 {
@@ -371,19 +376,21 @@ int mf_halo_build(mf_halo *h, mf_parallel *par, mf_particles *p, const mf_halo_s
             rc = MF_ERROR(MF_ERR_LIBRARY, "Zoltan_Comm_Create failed (halo of %zu copies)",
                           h->nsend);
     }
+    h->elem_cap = row > UPDATE_BYTES ? row : UPDATE_BYTES;
     if (rc == 0)
-        rc = grow((void **)&h->sbuf, &h->cap_sbuf, h->nsend * row + 1, 1);
+        rc = grow((void **)&h->sbuf, &h->cap_sbuf, h->nsend * h->elem_cap + 1, 1);
     if (rc == 0)
-        rc = grow((void **)&h->rbuf, &h->cap_rbuf, ((size_t)nrecv + 1) * row, 1);
+        rc = grow((void **)&h->rbuf, &h->cap_rbuf, ((size_t)nrecv + 1) * h->elem_cap, 1);
     if (rc == 0)
         rc = mf_particles_reserve(p, p->n_owned + h->nlocal + (size_t)nrecv);
     MF_CALL_GOTO(rc, mf_parallel_agree(par, rc), done);
     h->nrecv = (size_t)nrecv;
     for (size_t k = 0; k < h->nsend; k++)
         pack_copy(h, p, h->send_src[k], h->send_shift[k], h->sbuf + k * row);
+    /* (A failed exchange fails on the ranks that took part: no agreement.) */
     if (par && Zoltan_Comm_Do(h->plan, MF_TAG_HALO + 1, h->sbuf, (int)row, h->rbuf) != ZOLTAN_OK)
         rc = MF_ERROR(MF_ERR_LIBRARY, "Zoltan_Comm_Do failed (halo)");
-    MF_CALL_GOTO(rc, mf_parallel_agree(par, rc), done);
+    MF_CALL_GOTO(rc, rc, done);
     /* Local images straight from their owners, then the received copies. */
     for (size_t k = 0; k < h->nlocal; k++) {
         pack_copy(h, p, h->local_src[k], h->local_shift[k], h->rbuf + h->nrecv * row);
@@ -420,16 +427,20 @@ static int update(mf_halo *h, mf_parallel *par, const mf_particles *p, size_t si
     const double t0 = par ? MPI_Wtime() : 0;
     if (size > (size_t)INT32_MAX)
         return MF_ERROR(MF_ERR_INTERNAL, "halo update of %zu-byte values", size);
-    int rc = grow((void **)&h->sbuf, &h->cap_sbuf, h->nsend * size + 1, 1);
-    if (rc == 0)
-        rc = grow((void **)&h->rbuf, &h->cap_rbuf, (h->nrecv + 1) * size + 1, 1);
-    MF_CALL(mf_parallel_agree(par, rc));
+    int rc = 0;
+    if (size > h->elem_cap) { /* every rank: elem_cap and size are the same on all */
+        rc = grow((void **)&h->sbuf, &h->cap_sbuf, h->nsend * size + 1, 1);
+        if (rc == 0)
+            rc = grow((void **)&h->rbuf, &h->cap_rbuf, (h->nrecv + 1) * size + 1, 1);
+        MF_CALL(mf_parallel_agree(par, rc));
+        h->elem_cap = size;
+    }
     for (size_t k = 0; k < h->nsend; k++)
         get(ctx, h->send_src[k], h->send_shift[k], h->sbuf + k * size);
     if (par && Zoltan_Comm_Do(h->plan, MF_TAG_HALO_UPDATE, h->sbuf, (int)size, h->rbuf) !=
                    ZOLTAN_OK)
         rc = MF_ERROR(MF_ERR_LIBRARY, "Zoltan_Comm_Do failed (halo update)");
-    MF_CALL(mf_parallel_agree(par, rc));
+    MF_CALL(rc);
     char *tmp = h->rbuf + h->nrecv * size;
     for (size_t k = 0; k < h->nlocal; k++) {
         get(ctx, h->local_src[k], h->local_shift[k], tmp);

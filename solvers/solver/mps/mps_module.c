@@ -166,6 +166,23 @@ static void mps_report(void *data, const mf_sim *sim, mf_log *log)
                   1e3 * d->t_assembly / attempts, 1e3 * d->t_solve / attempts,
                   1e3 * d->t_setup / attempts, 1e3 * d->t_pcg / attempts,
                   1e3 * d->t_correction / attempts, 1e3 * total / attempts);
+    if (sim->par) { /* every rank's split: where the ranks wait for each other */
+        const int size = mf_parallel_size(sim->par);
+        double mine[5] = {d->t_neighbours, d->t_explicit, d->t_assembly, d->t_solve,
+                          d->t_correction};
+        double *all = malloc(5 * (size_t)size * sizeof *all);
+        if (all) {
+            mf_parallel_allgather(sim->par, mine, sizeof mine, all);
+            for (int r = 0; r < size && r < 16; r++)
+                mf_log_printf(log, MF_LOG_QUIET,
+                              "    rank %d (ms/step): neighbours and halo %.3f, explicit %.3f, "
+                              "assembly %.3f, solve %.3f, correction %.3f\n",
+                              r, 1e3 * all[5 * r] / attempts, 1e3 * all[5 * r + 1] / attempts,
+                              1e3 * all[5 * r + 2] / attempts, 1e3 * all[5 * r + 3] / attempts,
+                              1e3 * all[5 * r + 4] / attempts);
+            free(all);
+        }
+    }
     double rows = (double)d->ppe_rows; /* over the ranks */
     mf_parallel_sum(sim->par, &rows, 1);
     mf_log_printf(log, MF_LOG_QUIET,
