@@ -195,7 +195,7 @@ static void test_set(int dim, int nx, mf_decompose_method method)
     CHECK_OK(mf_parallel_distribute(par, p, p->next_id));
     check_ownership(par, p, total, "distribute");
     CHECK(mismatches(p, &f, 0, p->n_owned) == 0);
-    double imb = mf_parallel_imbalance(par, p);
+    double imb = mf_parallel_imbalance(par, p, NULL);
     if (rank == 0)
         printf("%d-D %s, %d ranks: %lld particles, imbalance after the first partition %.3f\n",
                dim, method == MF_DECOMPOSE_RCB ? "RCB" : "HSFC", nranks, (long long)total, imb);
@@ -290,7 +290,7 @@ static void test_set(int dim, int nx, mf_decompose_method method)
     mf_parallel_stats *st = mf_parallel_statistics(par);
     long rebalances = st ? st->rebalances : 0;
     CHECK_OK(mf_parallel_balance(par, p, false));
-    imb = mf_parallel_imbalance(par, p);
+    imb = mf_parallel_imbalance(par, p, NULL);
     if (rank == 0 && st)
         printf("    unbalanced start: imbalance %.3f, after rebalancing %.3f (%ld partitions)\n",
                st->imbalance_before, imb, st->rebalances);

@@ -31,6 +31,14 @@ static double now(void)
 
 /* ---- Zoltan's callbacks: the owned particles of par->zp ---------------- */
 
+/* The load of particle i: its kind's weight, more for a pressure wall. */
+static double load_of(const mf_parallel *par, const mf_particles *p, const uint8_t *walls,
+                      size_t i)
+{
+    const int k = p->kind[i] < MF_NKINDS ? p->kind[i] : 0;
+    return par->s.weight[k] + (walls && walls[i] ? par->s.weight_pressure_wall : 0.0);
+}
+
 static int num_obj(void *data, int *ierr)
 {
     const mf_parallel *par = data;
@@ -51,7 +59,7 @@ static void obj_list(void *data, int ngid, int nlid, ZOLTAN_ID_PTR gids, ZOLTAN_
         gids[(size_t)ngid * i + 1] = (ZOLTAN_ID_TYPE)(id >> 32);
         lids[i] = (ZOLTAN_ID_TYPE)i;
         if (wdim > 0)
-            weights[i] = (float)par->s.weight[p->kind[i] < MF_NKINDS ? p->kind[i] : 0];
+            weights[i] = (float)load_of(par, p, par->zwalls, i);
     }
     *ierr = ZOLTAN_OK;
 }
@@ -187,11 +195,12 @@ static bool in_box(const mf_parallel *par, const double *x, int dim)
 }
 
 /* Zoltan's partition of the owned particles, then the exports sent. */
-static int partition(mf_parallel *par, mf_particles *p)
+static int partition(mf_parallel *par, mf_particles *p, const uint8_t *walls)
 {
     const double t0 = now();
     MF_CALL(zoltan_setup(par, p->dim));
     par->zp = p;
+    par->zwalls = walls;
     int changes = 0, ngid = 0, nlid = 0, nimp = 0, nexp = 0;
     ZOLTAN_ID_PTR imp_gid = NULL, imp_lid = NULL, exp_gid = NULL, exp_lid = NULL;
     int *imp_proc = NULL, *imp_part = NULL, *exp_proc = NULL, *exp_part = NULL;
@@ -217,6 +226,7 @@ static int partition(mf_parallel *par, mf_particles *p)
     Zoltan_LB_Free_Part(&imp_gid, &imp_lid, &imp_proc, &imp_part);
     Zoltan_LB_Free_Part(&exp_gid, &exp_lid, &exp_proc, &exp_part);
     par->zp = NULL;
+    par->zwalls = NULL;
     MF_CALL(rc);
     par->partitioned = true;
     double *b = par->box;
@@ -282,13 +292,13 @@ static int migrate(mf_parallel *par, mf_particles *p, bool all_kinds)
 
 /* ---- the public calls -------------------------------------------------------- */
 
-double mf_parallel_imbalance(mf_parallel *par, const mf_particles *p)
+double mf_parallel_imbalance(mf_parallel *par, const mf_particles *p, const uint8_t *walls)
 {
     if (!par)
         return 1.0;
     double load = 0;
     for (size_t i = 0; i < p->n_owned; i++)
-        load += par->s.weight[p->kind[i] < MF_NKINDS ? p->kind[i] : 0];
+        load += load_of(par, p, walls, i);
     double total = load, heaviest = load;
     mf_parallel_sum(par, &total, 1);
     mf_parallel_max(par, &heaviest, 1);
@@ -297,25 +307,35 @@ double mf_parallel_imbalance(mf_parallel *par, const mf_particles *p)
     return par->stats.imbalance;
 }
 
-int mf_parallel_balance(mf_parallel *par, mf_particles *p, bool force)
+int mf_parallel_migrate(mf_parallel *par, mf_particles *p)
+{
+    if (!par || !par->partitioned)
+        return 0;
+    if (p->n != p->n_owned)
+        return MF_ERROR(MF_ERR_INTERNAL, "mf_parallel_migrate: drop the halo first");
+    MF_CALL(migrate(par, p, false));
+    return 0;
+}
+
+int mf_parallel_rebalance(mf_parallel *par, mf_particles *p, bool force, const uint8_t *walls)
 {
     if (!par)
         return 0;
     if (p->n != p->n_owned)
-        return MF_ERROR(MF_ERR_INTERNAL, "mf_parallel_balance: drop the halo first");
-    if (!par->partitioned || force) {
-        par->stats.imbalance_before = mf_parallel_imbalance(par, p);
-        MF_CALL(partition(par, p));
-        mf_parallel_imbalance(par, p);
+        return MF_ERROR(MF_ERR_INTERNAL, "mf_parallel_rebalance: drop the halo first");
+    const double imbalance = mf_parallel_imbalance(par, p, walls);
+    if (par->partitioned && !force && imbalance <= par->s.imbalance_threshold)
         return 0;
-    }
-    MF_CALL(migrate(par, p, false));
-    const double imbalance = mf_parallel_imbalance(par, p);
-    if (imbalance > par->s.imbalance_threshold) {
-        par->stats.imbalance_before = imbalance;
-        MF_CALL(partition(par, p));
-        mf_parallel_imbalance(par, p);
-    }
+    par->stats.imbalance_before = imbalance;
+    MF_CALL(partition(par, p, walls));
+    mf_parallel_imbalance(par, p, NULL); /* the walls' marks moved with the particles */
+    return 0;
+}
+
+int mf_parallel_balance(mf_parallel *par, mf_particles *p, bool force)
+{
+    MF_CALL(mf_parallel_migrate(par, p));
+    MF_CALL(mf_parallel_rebalance(par, p, force, NULL));
     return 0;
 }
 
@@ -341,7 +361,7 @@ int mf_parallel_distribute(mf_parallel *par, mf_particles *p, int64_t first_new_
     if (par->s.first_partition)
         MF_CALL(mf_parallel_balance(par, p, true));
     else
-        mf_parallel_imbalance(par, p);
+        mf_parallel_imbalance(par, p, NULL);
     return 0;
 }
 

@@ -45,6 +45,9 @@ typedef struct mf_parallel_settings {
     /* Load of one particle of each kind, relative to a fluid particle (the
      * walls and dummies of a scene do less work a step than its fluid). */
     double weight[MF_NKINDS];
+    /* Added for a wall particle that is an unknown of the pressure equation
+     * (walls beside the fluid; the others only count in neighbour lists). */
+    double weight_pressure_wall;
     /* false: mf_parallel_distribute leaves each rank its contiguous share of
      * the particles in the order they were built, and the first step makes
      * the first partition (a deliberately unbalanced start, for tests). */
@@ -132,13 +135,21 @@ void mf_parallel_abort(const mf_parallel *par, int rc);
  * partition moves each particle to its subdomain. Ids from here on come
  * from the rank's block after first_new_id. */
 int mf_parallel_distribute(mf_parallel *par, mf_particles *p, int64_t first_new_id);
-/* Before a step: particles that left this rank's region go to the rank
- * whose region holds them; a new partition when the imbalance passes the
- * threshold (or always when force is set). No halo may be present. */
+/* Before a step (no halo may be present): particles that left this rank's
+ * region go to the rank whose region holds them (mf_parallel_migrate);
+ * then a new partition when the imbalance passes the threshold, or always
+ * when force is set (mf_parallel_rebalance). pressure_walls (may be NULL)
+ * marks the owned walls that are unknowns of the pressure equation (their
+ * load is larger), for the particles as they are after the migration.
+ * mf_parallel_balance is the two with pressure_walls NULL. */
+int mf_parallel_migrate(mf_parallel *par, mf_particles *p);
+int mf_parallel_rebalance(mf_parallel *par, mf_particles *p, bool force,
+                          const uint8_t *pressure_walls);
 int mf_parallel_balance(mf_parallel *par, mf_particles *p, bool force);
-/* Weighted load of this rank's owned particles, and the imbalance (heaviest
- * rank over the mean; 1 when par is NULL). Collective. */
-double mf_parallel_imbalance(mf_parallel *par, const mf_particles *p);
+/* The imbalance of the weighted load (heaviest rank over the mean; 1 when
+ * par is NULL). Collective. */
+double mf_parallel_imbalance(mf_parallel *par, const mf_particles *p,
+                             const uint8_t *pressure_walls);
 /* Hysteresis of migration (RCB): a particle within this distance outside
  * its rank's box stays there, so that a lattice row lying on a cut does not
  * cross it back and forth with every rounding of its positions (0: none,

@@ -18,6 +18,7 @@ struct mf_parallel {
     bool partitioned;         /* cuts are known: mf_parallel_owner_of works */
     int geom_dim;             /* coordinates Zoltan sees (2 or 3) */
     const mf_particles *zp;   /* the particles Zoltan's callbacks read */
+    const uint8_t *zwalls;    /* and their pressure walls (may be NULL) */
     bool has_box;             /* RCB: this rank's region is the box below */
     double box[6];            /* min x, y, z, max x, y, z */
     double margin;            /* a particle this close outside its region stays */

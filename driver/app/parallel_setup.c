@@ -9,7 +9,7 @@
  *                              // step (a deliberately unbalanced start)
  *   imbalanceThreshold  1.1;   // a new partition when the heaviest rank carries
  *                              // more than this times the mean load
- *   weights { fluid 1; wall 1; dummy 0.25; inlet 1; outlet 1; }
+ *   weights { fluid 1; wall 0.35; dummy 0.2; inlet 1; outlet 1; }
  *
  * Every rank reads the case and builds the whole scene (or reads the whole
  * restart snapshot); mf_app_distribute then keeps each rank's share and the
@@ -54,9 +54,9 @@ static const mf_param decompose_params[] = {
 static const mf_param weight_params[] = {
     {"fluid", MF_PARAM_SCALAR, "1", 0, 1e6, NULL, offsetof(weight_settings, w[MF_FLUID]),
      "load of a fluid particle"},
-    {"wall", MF_PARAM_SCALAR, "1", 0, 1e6, NULL, offsetof(weight_settings, w[MF_WALL]),
+    {"wall", MF_PARAM_SCALAR, "0.35", 0, 1e6, NULL, offsetof(weight_settings, w[MF_WALL]),
      "load of a wall particle (in the pressure equation)"},
-    {"dummy", MF_PARAM_SCALAR, "0.25", 0, 1e6, NULL, offsetof(weight_settings, w[MF_DUMMY]),
+    {"dummy", MF_PARAM_SCALAR, "0.2", 0, 1e6, NULL, offsetof(weight_settings, w[MF_DUMMY]),
      "load of a dummy particle (number density only)"},
     {"inlet", MF_PARAM_SCALAR, "1", 0, 1e6, NULL, offsetof(weight_settings, w[MF_INLET]),
      "load of an inlet particle"},

@@ -125,6 +125,15 @@ int mps_halo_add_field(mps_data *d, int field)
     return 0;
 }
 
+/* d->dirichlet (scratch until the surface phase): the owned walls that
+ * were unknowns of the last pressure equation (no free-surface flag). */
+static void pressure_walls(mps_data *d, const mf_particles *p)
+{
+    const int32_t *flags = mf_particles_fi(p, d->f_flags);
+    for (size_t i = 0; i < p->n_owned; i++)
+        d->dirichlet[i] = p->kind[i] == MF_WALL && !(flags[i] & MPS_FLAG_SURFACE);
+}
+
 int mps_halo_begin(mps_data *d, mf_sim *sim, bool step_start)
 {
     mps_halo *mh = d->halo;
@@ -135,11 +144,20 @@ int mps_halo_begin(mps_data *d, mf_sim *sim, bool step_start)
         return 0;
     mf_parallel_stats *st = mf_parallel_statistics(sim->par);
     const long before = st->rebalances;
-    MF_CALL(mf_parallel_balance(sim->par, p, false));
-    if (st->rebalances != before)
+    MF_CALL(mf_parallel_migrate(sim->par, p));
+    /* The load: walls beside the fluid are unknowns of the pressure
+     * equation (no free-surface flag after the last step), the others only
+     * count in the neighbour lists. */
+    MF_CALL(mps_reserve(d, p->n));
+    pressure_walls(d, p);
+    MF_CALL(mf_parallel_rebalance(sim->par, p, false, d->dirichlet));
+    if (st->rebalances != before) { /* the flags moved with the particles */
+        MF_CALL(mps_reserve(d, p->n));
+        pressure_walls(d, p);
+        mf_parallel_imbalance(sim->par, p, d->dirichlet);
         mf_log_printf(sim->log, MF_LOG_NORMAL, "Rebalanced: load imbalance %.3f, now %.3f\n",
                       st->imbalance_before, st->imbalance);
-    MF_CALL(mps_reserve(d, p->n));
+    }
     return 0;
 }
 
