@@ -136,21 +136,24 @@ static int exchange(mf_parallel *par, mf_particles *p, const size_t *idx, int *d
     char *send = malloc(n * row + 1), *recv = NULL;
     uint8_t *gone = calloc(p->n_owned + 1, 1);
     ZOLTAN_COMM_OBJ *plan = NULL;
-    if (!send || !gone)
+    /* One agreement: a rank that failed to allocate still takes part in the
+     * plan (sending nothing) and reports after it. */
+    if (!send || !gone) {
         rc = MF_ERROR(MF_ERR_MEMORY, "out of memory packing %zu migrating particles", n);
-    MF_CALL_GOTO(rc, mf_parallel_agree(par, rc), done);
-    mf_particles_pack(p, idx, n, send);
-    if (Zoltan_Comm_Create(&plan, (int)n, dest, par->comm, MF_TAG_MIGRATE, &nrecv) != ZOLTAN_OK)
+        n = 0;
+    } else {
+        mf_particles_pack(p, idx, n, send);
+    }
+    if (Zoltan_Comm_Create(&plan, (int)n, dest, par->comm, MF_TAG_MIGRATE, &nrecv) != ZOLTAN_OK &&
+        rc == 0)
         rc = MF_ERROR(MF_ERR_LIBRARY, "Zoltan_Comm_Create failed (migration of %zu particles)",
                       n);
-    MF_CALL_GOTO(rc, mf_parallel_agree(par, rc), done);
-    recv = malloc((size_t)nrecv * row + 1);
-    if (!recv)
+    if (rc == 0 && !(recv = malloc((size_t)nrecv * row + 1)))
         rc = MF_ERROR(MF_ERR_MEMORY, "out of memory receiving %d migrating particles", nrecv);
     MF_CALL_GOTO(rc, mf_parallel_agree(par, rc), done);
     if (Zoltan_Comm_Do(plan, MF_TAG_MIGRATE + 1, send, (int)row, recv) != ZOLTAN_OK)
         rc = MF_ERROR(MF_ERR_LIBRARY, "Zoltan_Comm_Do failed (migration)");
-    MF_CALL_GOTO(rc, mf_parallel_agree(par, rc), done);
+    MF_CALL_GOTO(rc, rc, done);
     for (size_t k = 0; k < n; k++)
         gone[idx[k]] = 1;
     size_t removed = 0;

@@ -50,6 +50,7 @@ struct mf_halo {
     candidate *cand;
     size_t cap_cand;
     size_t elem_cap; /* the buffers hold this many bytes a copy (the same on every rank) */
+    double *boxes;   /* 6 a rank: the owned particles' bounding boxes */
 };
 
 /* Updates of values up to this size (9 doubles: any particle field) find
@@ -78,6 +79,7 @@ void mf_halo_destroy(mf_halo *h)
     free(h->sbuf);
     free(h->rbuf);
     free(h->cand);
+    free(h->boxes);
     free(h);
 }
 
@@ -353,18 +355,24 @@ int mf_halo_build(mf_halo *h, mf_parallel *par, mf_particles *p, const mf_halo_s
     h->spec = *spec;
     int rc = check_spec(spec, p);
     const int nranks = par ? par->size : 1;
-    double *boxes = malloc(6 * (size_t)nranks * sizeof *boxes);
-    if (rc == 0 && !boxes)
+    MF_CALL(rc); /* the same spec on every rank: the same answer */
+    /* One agreement, after the plan: a rank that failed before it still
+     * takes part (sending nothing) and reports then. */
+    if (!h->boxes && !(h->boxes = malloc(6 * (size_t)nranks * sizeof *h->boxes))) {
         rc = MF_ERROR(MF_ERR_MEMORY, "out of memory for %d subdomain boxes", nranks);
-    MF_CALL_GOTO(rc, mf_parallel_agree(par, rc), done);
-    double mine[6];
+        mf_parallel_abort(par, rc); /* 48 bytes a rank: cannot even take part */
+        return rc;
+    }
+    double *boxes = h->boxes, mine[6];
     owned_box(p, mine);
     const double t_wait = par ? MPI_Wtime() : 0;
     mf_parallel_allgather(par, mine, sizeof mine, boxes);
     if (par)
         par->stats.t_halo_wait += MPI_Wtime() - t_wait;
-    rc = plan_copies(h, par, p, boxes);
-    MF_CALL_GOTO(rc, mf_parallel_agree(par, rc), done);
+    if (rc == 0)
+        rc = plan_copies(h, par, p, boxes);
+    if (rc != 0)
+        h->nsend = h->nlocal = 0;
 
     const size_t row = copy_bytes(h, p);
     int nrecv = 0;
@@ -372,7 +380,8 @@ int mf_halo_build(mf_halo *h, mf_parallel *par, mf_particles *p, const mf_halo_s
         Zoltan_Comm_Destroy(&h->plan);
     if (par) {
         if (Zoltan_Comm_Create(&h->plan, (int)h->nsend, h->send_rank, par->comm, MF_TAG_HALO,
-                               &nrecv) != ZOLTAN_OK)
+                               &nrecv) != ZOLTAN_OK &&
+            rc == 0)
             rc = MF_ERROR(MF_ERR_LIBRARY, "Zoltan_Comm_Create failed (halo of %zu copies)",
                           h->nsend);
     }
@@ -408,7 +417,6 @@ int mf_halo_build(mf_halo *h, mf_parallel *par, mf_particles *p, const mf_halo_s
         par->stats.t_halo += MPI_Wtime() - t0;
     }
 done:
-    free(boxes);
     return rc;
 }
 

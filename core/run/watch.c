@@ -283,17 +283,20 @@ static int check_energy(mf_watch *w, const mf_sim *sim, double dt)
 }
 
 /* On several ranks the local checks (nonFinite, throughWall) are agreed on
- * at once, so that every rank reports the same criterion and particle and
- * none goes on to the collective checks alone; those (densityCollapse,
- * energy) reduce over the ranks and name the particle on every rank. */
+ * once, so that every rank reports the same criterion and particle and none
+ * goes on to the collective checks alone; those (densityCollapse, energy)
+ * decide from sums over the ranks, the same on every rank, and name the
+ * particle on every rank. */
 int mf_watch_check(mf_watch *w, const mf_sim *sim, double dt)
 {
-    MF_CALL(mf_parallel_agree(sim->par, check_non_finite(sim)));
+    int rc = check_non_finite(sim);
+    if (rc == 0 && w->s.enabled)
+        rc = check_walls(sim);
+    MF_CALL(mf_parallel_agree(sim->par, rc));
     if (!w->s.enabled)
         return 0;
-    MF_CALL(mf_parallel_agree(sim->par, check_walls(sim)));
     MF_CALL(check_density(w, sim));
-    MF_CALL(mf_parallel_agree(sim->par, check_energy(w, sim, dt)));
+    MF_CALL(check_energy(w, sim, dt));
     return 0;
 }
 

@@ -67,14 +67,15 @@ static int regularise_closed_groups(mps_data *d, const mf_sim *sim, const mf_nli
     int rc = !seen || !queue || (across && !flag)
                  ? MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu pressure rows", nrows)
                  : 0;
-    MF_CALL_GOTO(rc, mf_parallel_agree(sim->par, rc), done);
+    if (rc != 0 && !across)
+        goto done;
     size_t head = 0, tail = 0;
-    for (size_t r = 0; r < nrows; r++)
+    for (size_t r = 0; rc == 0 && r < nrows; r++)
         if (touches_dirichlet[r]) {
             seen[r] = 1;
             queue[tail++] = r;
         }
-    for (;;) {
+    for (int round = 0;; round++) {
         while (head < tail) {
             size_t r = queue[head++];
             for (size_t k = d->A.rowptr[r]; k < d->A.rowptr[r + 1]; k++) {
@@ -87,6 +88,18 @@ static int regularise_closed_groups(mps_data *d, const mf_sim *sim, const mf_nli
         }
         if (!across)
             break;
+        if (round == 0) { /* the usual case: every row reached on every rank */
+            double open[2] = {(double)(nrows - tail), rc != 0};
+            if (rc != 0)
+                open[0] = 0;
+            mf_parallel_sum(sim->par, open, 2);
+            if (open[1] > 0) {
+                rc = mf_parallel_agree(sim->par, rc);
+                goto done;
+            }
+            if (open[0] == 0)
+                break;
+        }
         for (size_t i = 0; i < p->n_owned; i++)
             flag[i] = d->row[i] >= 0 && seen[d->row[i] - offset];
         MF_CALL_GOTO(rc, mps_halo_sync(d, sim, flag, 1), done);
