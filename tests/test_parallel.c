@@ -237,7 +237,7 @@ static void test_set(int dim, int nx, mf_decompose_method method)
      * wrapped into the period first, walls are inside it already). */
     mf_halo *h = NULL;
     CHECK_OK(mf_halo_create(&h));
-    mf_halo_spec hs = {.radius = 2.1, .nfields = 1, .field = {f.scalar}};
+    mf_halo_spec hs = {.radius = 2.1, .velocities = true, .nfields = 1, .field = {f.scalar}};
     CHECK_OK(mf_halo_build(h, par, p, &hs));
     check_halo(p, hs.radius, 0, "halo");
     CHECK(mismatches(p, &f, p->n_owned, p->n) == 0 || hs.nfields < 2);

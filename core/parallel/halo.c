@@ -281,7 +281,7 @@ static int plan_copies(mf_halo *h, const mf_parallel *par, const mf_particles *p
 /* Bytes of one copy: position, velocity, kind, id and the named fields. */
 static size_t copy_bytes(const mf_halo *h, const mf_particles *p)
 {
-    size_t b = 6 * sizeof(double) + sizeof(uint8_t) + sizeof(int64_t);
+    size_t b = (h->spec.velocities ? 6 : 3) * sizeof(double) + sizeof(uint8_t) + sizeof(int64_t);
     for (int k = 0; k < h->spec.nfields; k++)
         b += mf_particles_field_bytes(&p->field[h->spec.field[k]]);
     return b;
@@ -293,8 +293,10 @@ static void pack_copy(const mf_halo *h, const mf_particles *p, size_t i, int shi
     shifted(&h->spec, &p->pos[3 * i], shift, y);
     memcpy(out, y, sizeof y);
     out += sizeof y;
-    memcpy(out, &p->vel[3 * i], 3 * sizeof(double));
-    out += 3 * sizeof(double);
+    if (h->spec.velocities) {
+        memcpy(out, &p->vel[3 * i], 3 * sizeof(double));
+        out += 3 * sizeof(double);
+    }
     memcpy(out, &p->kind[i], 1);
     out += 1;
     memcpy(out, &p->id[i], sizeof(int64_t));
@@ -311,8 +313,12 @@ static void unpack_copy(const mf_halo *h, mf_particles *p, size_t j, const char 
 {
     memcpy(&p->pos[3 * j], in, 3 * sizeof(double));
     in += 3 * sizeof(double);
-    memcpy(&p->vel[3 * j], in, 3 * sizeof(double));
-    in += 3 * sizeof(double);
+    if (h->spec.velocities) {
+        memcpy(&p->vel[3 * j], in, 3 * sizeof(double));
+        in += 3 * sizeof(double);
+    } else {
+        memset(&p->vel[3 * j], 0, 3 * sizeof(double));
+    }
     memcpy(&p->kind[j], in, 1);
     in += 1;
     memcpy(&p->id[j], in, sizeof(int64_t));

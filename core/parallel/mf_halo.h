@@ -10,9 +10,9 @@
  *     the upper face by -L (on this rank, or sent to the rank that needs
  *     them), so that the loops see across the period without a minimum-image
  *     rule in any kernel.
- * Each copy keeps its owner's id, kind, position (shifted for an image) and
- * velocity, plus only the optional fields the caller names: nothing else
- * crosses the network. Later values of an array computed on the owned
+ * Each copy keeps its owner's id, kind and position (shifted for an image),
+ * plus its velocity and the optional fields when the caller asks for them:
+ * nothing else crosses the network. Later values of an array computed on the owned
  * particles reach the copies through mf_halo_update with the same plan (the
  * pressure after the solve, a particle's global matrix row, a mask), so an
  * image or a remote copy is always the same unknown as its owner.
@@ -38,7 +38,9 @@ typedef struct mf_halo_spec {
     /* A periodic axis (length 0: none): particles live in [origin, origin + length). */
     int periodic_axis;
     double periodic_origin, periodic_length;
-    /* Optional fields copied with positions, velocities, kinds and ids. */
+    /* Velocities copied (else the copies' are zero: a phase that reads none). */
+    bool velocities;
+    /* Optional fields copied with positions, kinds and ids. */
     int nfields;
     int field[MF_MAX_FIELDS];
 } mf_halo_spec;

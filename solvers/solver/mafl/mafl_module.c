@@ -103,7 +103,7 @@ static int create_data(mafl_data *d, mf_sim *sim, const mf_dict *solver_dict)
     /* On several ranks: the MPS phases' copies carry r^n (the PPE source of
      * densityReference startOfStep and divergence reads it), and the MAFL
      * phases have copies of their own. */
-    MF_CALL(mps_halo_add_field(d->mps, d->f_pos_n));
+    MF_CALL(mps_halo_add_field(d->mps, d->f_pos_n, MPS_HALO_STAR));
     if (sim->par)
         MF_CALL(mf_halo_create(&d->halo));
     /* Inlet and outlet points are computation points that stay in place. */

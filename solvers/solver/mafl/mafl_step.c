@@ -99,7 +99,7 @@ int mafl_copies(mafl_data *d, mf_sim *sim, double radius, bool values)
 {
     if (!d->halo)
         return 0;
-    mf_halo_spec spec = {.radius = radius};
+    mf_halo_spec spec = {.radius = radius, .velocities = values};
     if (values) {
         spec.field[spec.nfields++] = d->f_kind;
         spec.field[spec.nfields++] = d->mps->f_flags;

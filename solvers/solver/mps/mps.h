@@ -236,12 +236,14 @@ void mps_viscosity_report(const struct mps_viscosity *v, const mf_sim *sim, mf_l
  * pressure). Nothing of it exists in a serial run without a period. */
 int mps_halo_create(mps_data *d, mf_sim *sim);
 void mps_halo_destroy(struct mps_halo *mh);
-/* A particle field the copies carry from the start (FluidId, scalars). */
-int mps_halo_add_field(mps_data *d, int field);
+/* A particle field the copies carry, at r^n (the explicit phase) and/or at
+ * r* (the pressure phase). */
+enum { MPS_HALO_START = 1, MPS_HALO_STAR = 2 };
+int mps_halo_add_field(mps_data *d, int field, int when);
 /* Drop the copies, wrap the period; at the first build of a step
  * (step_start) particles also migrate between ranks. */
 int mps_halo_begin(mps_data *d, mf_sim *sim, bool step_start);
-int mps_halo_add(mps_data *d, mf_sim *sim);     /* build the copies */
+int mps_halo_add(mps_data *d, mf_sim *sim, bool at_star); /* build the copies */
 void mps_halo_end(mps_data *d, mf_sim *sim);    /* drop them, wrap */
 /* The copies of values (n values of size bytes each) from their owners.
  * Collective; nothing without a halo. */

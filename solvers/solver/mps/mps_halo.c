@@ -39,7 +39,8 @@
 
 typedef struct mps_halo {
     mf_halo *h;
-    mf_halo_spec spec;
+    mf_halo_spec spec;  /* at r^n: velocities and the fields of the explicit phase */
+    mf_halo_spec star;  /* at r*: what the pressure phase reads */
 } mps_halo;
 
 static double largest_radius(const mps_data *d)
@@ -92,6 +93,7 @@ int mps_halo_create(mps_data *d, mf_sim *sim)
         return mf_error_trace(rc, __FILE__, __LINE__, __func__);
     }
     mh->spec.radius = radius;
+    mh->spec.velocities = true; /* viscosity, the collision model, the forces */
     if (periodic) {
         mh->spec.periodic_axis = 0;
         mh->spec.periodic_origin = d->s.periodic_origin;
@@ -99,6 +101,8 @@ int mps_halo_create(mps_data *d, mf_sim *sim)
         mf_log_printf(sim->log, MF_LOG_NORMAL, "Periodic in x: [%g, %g), images within %g m\n",
                       d->s.periodic_origin, d->s.periodic_origin + d->s.periodic_length, rmax);
     }
+    mh->star = mh->spec;
+    mh->star.velocities = false; /* the PPE and the correction read none */
     d->halo = mh;
     return 0;
 }
@@ -111,17 +115,26 @@ void mps_halo_destroy(mps_halo *mh)
     free(mh);
 }
 
-int mps_halo_add_field(mps_data *d, int field)
+static int add_to(mf_halo_spec *s, int field)
+{
+    for (int k = 0; k < s->nfields; k++)
+        if (s->field[k] == field)
+            return 0;
+    if (s->nfields == MF_MAX_FIELDS)
+        return MF_ERROR(MF_ERR_INTERNAL, "too many halo fields");
+    s->field[s->nfields++] = field;
+    return 0;
+}
+
+int mps_halo_add_field(mps_data *d, int field, int when)
 {
     mps_halo *mh = d->halo;
     if (!mh)
         return 0;
-    for (int k = 0; k < mh->spec.nfields; k++)
-        if (mh->spec.field[k] == field)
-            return 0;
-    if (mh->spec.nfields == MF_MAX_FIELDS)
-        return MF_ERROR(MF_ERR_INTERNAL, "too many halo fields");
-    mh->spec.field[mh->spec.nfields++] = field;
+    if (when & MPS_HALO_START)
+        MF_CALL(add_to(&mh->spec, field));
+    if (when & MPS_HALO_STAR)
+        MF_CALL(add_to(&mh->star, field));
     return 0;
 }
 
@@ -161,11 +174,11 @@ int mps_halo_begin(mps_data *d, mf_sim *sim, bool step_start)
     return 0;
 }
 
-int mps_halo_add(mps_data *d, mf_sim *sim)
+int mps_halo_add(mps_data *d, mf_sim *sim, bool at_star)
 {
     mps_halo *mh = d->halo;
     mf_particles *p = sim->p;
-    MF_CALL(mf_halo_build(mh->h, sim->par, p, &mh->spec));
+    MF_CALL(mf_halo_build(mh->h, sim->par, p, at_star ? &mh->star : &mh->spec));
     MF_CALL(mps_reserve(d, p->n));
     /* What a copy is follows from its kind; what the phases compute later
      * (free surface, PPE rows, pressure) comes from its owner by sync. */

@@ -54,7 +54,7 @@ int mps_build_neighbours(mps_data *d, mf_sim *sim, bool reorder)
         MF_CALL(mf_grid_build(&d->grid, p, rmax));
     }
     if (d->halo) { /* copies from other ranks and across the period, then the grid again */
-        MF_CALL(mps_halo_add(d, sim));
+        MF_CALL(mps_halo_add(d, sim, !reorder)); /* reorder: the build at r^n */
         MF_CALL(mf_grid_build(&d->grid, p, rmax));
     }
     MF_CALL(mf_nlist_build(&d->nl_max, &d->grid, p, rmax));
