@@ -17,7 +17,7 @@
 
 #include "case_util.h"
 #include "mf_dictio.h"
-#include "mf_neighbours.h"
+#include "mf_pairs.h"
 #include "mf_test.h"
 
 #define END_TIME 0.35
@@ -101,6 +101,15 @@ static int read_csv(const char *path, int ca, int cb, series *s)
     return s->n > 0 ? 0 : -1;
 }
 
+/* Counts a particle's neighbours. */
+static inline bool count_pair(void *acc, const void *ctx, const mf_pair *pr)
+{
+    (void)ctx;
+    (void)pr;
+    ++*(size_t *)acc;
+    return true;
+}
+
 /* The front of one snapshot, as metric_surge_front.c: m from the back wall. */
 static double front_of(const mf_particles *all, double l0, double back_wall, size_t *counted)
 {
@@ -119,12 +128,16 @@ static double front_of(const mf_particles *all, double l0, double back_wall, siz
     *counted = 0;
     if (fluid->n > 0 && mf_grid_build(&g, fluid, radius) == 0 &&
         mf_nlist_build(&nl, &g, fluid, radius) == 0) {
-        for (size_t i = 0; i < fluid->n; i++)
-            if (nl.start[i + 1] - nl.start[i] >= 2) {
+        const mf_pairs v = mf_pairs_of_list(fluid, &nl, radius);
+        for (size_t i = 0; i < fluid->n; i++) {
+            size_t count = 0;
+            mf_pairs_row_r2(&v, i, NULL, count_pair, NULL, &count);
+            if (count >= 2) {
                 (*counted)++;
                 if (fluid->pos[3 * i] - back_wall > z)
                     z = fluid->pos[3 * i] - back_wall;
             }
+        }
     } else {
         mf_error_print(stderr);
         z = NAN;

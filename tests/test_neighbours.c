@@ -289,7 +289,7 @@ static void test_tiny_sets(void)
     const double far[3] = {10.0, -2.0, 3.0}, below[3] = {-10.0, -2.0, 3.0};
     CHECK(mf_grid_point_cell(&g, far) == -1);
     CHECK(mf_grid_point_cell(&g, below) == -1);
-    CHECK(mf_nlist_memory(&nl) >= 2 * sizeof(size_t));
+    CHECK(mf_nlist_memory(&nl) >= 2 * sizeof(uint32_t));
     CHECK(mf_grid_memory(&g) > 0);
     mf_particles_destroy(p1);
 
@@ -431,7 +431,7 @@ static void test_filter(void)
     compare_with_brute_force(&small, p, 0.35, "filtered list");
     /* Same grid: the filtered list keeps the build's order exactly. */
     CHECK(small.start[p->n] == direct.start[p->n]);
-    CHECK(memcmp(small.start, direct.start, (p->n + 1) * sizeof(size_t)) == 0);
+    CHECK(memcmp(small.start, direct.start, (p->n + 1) * sizeof(uint32_t)) == 0);
     CHECK(memcmp(small.j, direct.j, direct.start[p->n] * sizeof(uint32_t)) == 0);
     /* Filtering at the same radius is the identity. */
     CHECK_OK(mf_nlist_filter(&small, &big, p, 0.6));
@@ -505,7 +505,7 @@ static void test_determinism(void)
     omp_set_num_threads(threads);
     CHECK(a.start[p->n] == b.start[p->n]);
     CHECK(a.start[p->n] > 0);
-    CHECK(memcmp(a.start, b.start, (p->n + 1) * sizeof(size_t)) == 0);
+    CHECK(memcmp(a.start, b.start, (p->n + 1) * sizeof(uint32_t)) == 0);
     CHECK(memcmp(a.j, b.j, a.start[p->n] * sizeof(uint32_t)) == 0);
     mf_nlist_free(&a);
     mf_nlist_free(&b);

@@ -71,10 +71,11 @@ static errors measure(int dim, int m, double re_l0, double jitter, bool print)
         u[3 * i + 1] = x[1];
         u[3 * i + 2] = x[2]; /* div u = d */
     }
-    mf_number_density(p, &nl, NULL, NULL, nd);
-    mf_gradient(p, &nl, &k, f, false, NULL, NULL, grad);
-    mf_divergence(p, &nl, &k, u, NULL, NULL, div);
-    mf_laplacian(p, &nl, &k, q, 1, NULL, NULL, lap);
+    const mf_pairs v = mf_pairs_of_list(p, &nl, k.re);
+    mf_number_density(&v, NULL, NULL, nd);
+    mf_gradient(&v, &k, f, false, NULL, NULL, grad);
+    mf_divergence(&v, &k, u, NULL, NULL, div);
+    mf_laplacian(&v, &k, q, 1, NULL, NULL, lap);
     errors e = {0, 0, 0, 0};
     const double margin = (ceil(re_l0) + 1) * l0, hi = (m - 1) * l0 - margin;
     size_t counted = 0;
@@ -168,7 +169,8 @@ static void test_free_surface(void)
     CHECK_OK(mf_nlist_build(&nl, &g, p, k.re));
     double nd[100];
     uint8_t flag[100];
-    mf_number_density(p, &nl, NULL, NULL, nd);
+    const mf_pairs v = mf_pairs_of_list(p, &nl, k.re);
+    mf_number_density(&v, NULL, NULL, nd);
     mf_free_surface(nd, p->n, 0.97, k.n0, flag);
     int surface = 0;
     for (size_t i = 0; i < p->n; i++) {

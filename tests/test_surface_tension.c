@@ -54,6 +54,7 @@ static void world_init(world *w, int dim, int nfluids, const double *rho, const 
         w->sim.fluid[k].sigma = sigma[k];
     }
     CHECK_OK(mf_particles_create(dim, 4096, &w->sim.p));
+    CHECK_OK(mf_neighbours_create(&w->sim.neighbours));
     w->f_fluid = -1;
     if (nfluids > 1)
         CHECK_OK(mf_particles_request_field(w->sim.p, "FluidId", 1, MF_FIELD_INT32, true,
@@ -63,6 +64,7 @@ static void world_init(world *w, int dim, int nfluids, const double *rho, const 
 static void world_free(world *w)
 {
     mf_particles_destroy(w->sim.p);
+    mf_neighbours_destroy(w->sim.neighbours);
     mf_registry_destroy(w->reg);
 }
 

@@ -34,15 +34,19 @@ typedef struct mf_solver_ops {
 
 /* ---- pressure: solves the (symmetric positive definite) PPE ------------- */
 /* Local rows of a distributed sparse matrix in CSR form. Columns are global
- * indices; this rank owns rows [row_offset, row_offset + nrows). */
+ * indices; this rank owns rows [row_offset, row_offset + nrows). Columns are
+ * 32-bit, as the hypre of the platform's packages (HYPRE_BigInt is int
+ * without --enable-bigint): the matrix is the largest array of a run, and a
+ * system has fewer than 2^31 unknowns in all. */
 typedef struct mf_csr {
     size_t nrows;
     int64_t row_offset;
     int64_t nglobal;
     size_t *rowptr;   /* nrows + 1 */
-    int64_t *col;     /* rowptr[nrows] */
+    int32_t *col;     /* rowptr[nrows] */
     double *val;      /* rowptr[nrows] */
 } mf_csr;
+#define MF_CSR_MAX_GLOBAL INT32_MAX
 
 typedef struct mf_solve_report {
     int iterations;

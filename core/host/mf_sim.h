@@ -64,11 +64,10 @@ typedef struct mf_sim {
     /* Modules the case names, in order. */
     size_t nforces;
     mf_module *forces;         /* kind MF_KIND_FORCE */
-    /* Neighbours of the particles at their current positions (radius:
-     * neighbours->radius), set by the solver while forces accumulate and NULL
-     * otherwise: a force that needs neighbours uses it when the radius is
-     * large enough, else builds its own. */
-    const mf_nlist *neighbours;
+    /* The neighbour service (mf_neighbours.h), created with the sim and
+     * shared by every module: a module requests its radius once
+     * (mf_neighbours_request) and asks for the pairs when it loops. */
+    mf_neighbours *neighbours;
     /* Walls of the scene (box walls), for the watch. */
     size_t nwall_boxes;
     mf_wall_box *wall_boxes;

@@ -1,10 +1,14 @@
-/* mf_operators.h: the MPS differential operators (section 3.1).
+/* mf_operators.h: the MPS differential operators (section 3.1) and the
+ * collision model, on the pair engine (mf_pairs.h).
  *
- * Each operator loops over owned particles i (those with imask[i] != 0, or
- * all when imask is NULL) and their neighbours j in a list (those with
- * jmask[j] != 0, or all when jmask is NULL). The pair terms are the small
- * inline functions of mf_kernel.h. Loops run in parallel (OpenMP).
- * Particles outside imask are left untouched in the output. */
+ * Each operator runs over the owned particles i in imask (NULL: all) and
+ * their neighbours j in a view (mf_neighbours_pairs) and in jmask (NULL:
+ * all); the view's radius is the operator's re. The pair terms are the
+ * inline kernels of mf_kernel.h. Particles outside imask are left untouched
+ * in the output. Loops run in parallel (OpenMP); each particle's sum runs
+ * over its neighbours in the view's order, so results do not depend on the
+ * thread count.
+ */
 #ifndef MF_OPERATORS_H
 #define MF_OPERATORS_H
 
@@ -12,28 +16,60 @@
 #include <stdint.h>
 
 #include "mf_kernel.h"
-#include "mf_neighbours.h"
+#include "mf_pairs.h"
 #include "mf_particles.h"
 
-/* n_i = sum_j w(|r_ij|) with the list's own radius as re. */
-void mf_number_density(const mf_particles *p, const mf_nlist *nl, const uint8_t *imask,
-                       const uint8_t *jmask, double *n);
+/* n_i = sum_j w(|r_ij|) with the view's radius as re. */
+void mf_number_density(const mf_pairs *v, const uint8_t *imask, const uint8_t *jmask,
+                       double *n);
 
-/* eq. 5: <grad f>_i = d/n0 sum_j (f_j - f_i') r_ij/|r_ij|^2 w(|r_ij|), where
- * f_i' = f_i, or with use_min the minimum of f over i and its (jmask)
- * neighbours (Koshizuka et al. 1998: keeps the pressure force repulsive).
- * out has 3 entries per particle. */
-void mf_gradient(const mf_particles *p, const mf_nlist *nl, const mf_kernel *k, const double *f,
-                 bool use_min, const uint8_t *imask, const uint8_t *jmask, double *out);
+/* eq. 5: <grad f>_i = d/n0 sum_j c_ij (f_j - f^_i) r_ij/|r_ij|^2 w(|r_ij|). */
+typedef struct mf_gradient_opts {
+    const double *f;
+    /* f^_i: f_i, or with use_min the minimum of f over i and its (jmask)
+     * neighbours (Koshizuka et al. 1998: keeps the pressure force
+     * repulsive), except for the particles of own_reference (NULL: none). */
+    bool use_min;
+    const uint8_t *own_reference;
+    /* c_ij: 1/rho_ij, the pair average of rho (mf_inv_rho_pair), or the
+     * constant coef when rho is NULL. */
+    const double *rho;
+    int rho_average;
+    double coef;
+} mf_gradient_opts;
+void mf_gradient_ex(const mf_pairs *v, const mf_kernel *k, const mf_gradient_opts *o,
+                    const uint8_t *imask, const uint8_t *jmask, double *out);
+/* The plain gradient: c_ij = 1. out has 3 entries per particle. */
+void mf_gradient(const mf_pairs *v, const mf_kernel *k, const double *f, bool use_min,
+                 const uint8_t *imask, const uint8_t *jmask, double *out);
 
 /* eq. 7: <lap f>_i = 2d/(lambda n0) sum_j (f_j - f_i) w(|r_ij|) for a field
- * of ncomp interleaved components (1 or 3). */
-void mf_laplacian(const mf_particles *p, const mf_nlist *nl, const mf_kernel *k, const double *f,
-                  int ncomp, const uint8_t *imask, const uint8_t *jmask, double *out);
+ * of ncomp interleaved components (1 or 3): out = <lap f>. */
+void mf_laplacian(const mf_pairs *v, const mf_kernel *k, const double *f, int ncomp,
+                  const uint8_t *imask, const uint8_t *jmask, double *out);
+/* out += scale <lap f> (3 components): the viscous term nu <lap u> of eq. 9. */
+void mf_laplacian_add(const mf_pairs *v, const mf_kernel *k, const double *f, double scale,
+                      const uint8_t *imask, const uint8_t *jmask, double *out);
+/* eq. 27's viscous term with a pair viscosity: out_i += 2d/(lambda n0)
+ * (1/rho_i) sum_j mu_ij (u_j - u_i) w_ij, mu_ij the pair average of mu
+ * (mf_mu_pair) where j is in mu_mask, mu_i where it is not (3 components). */
+void mf_laplacian_mu(const mf_pairs *v, const mf_kernel *k, const double *f, const double *mu,
+                     int mu_average, const uint8_t *mu_mask, const double *rho,
+                     const uint8_t *imask, double *out);
 
 /* eq. 6: <div u>_i = d/n0 sum_j (u_j - u_i).r_ij/|r_ij|^2 w(|r_ij|). */
-void mf_divergence(const mf_particles *p, const mf_nlist *nl, const mf_kernel *k, const double *u,
+void mf_divergence(const mf_pairs *v, const mf_kernel *k, const double *u,
                    const uint8_t *imask, const uint8_t *jmask, double *out);
+
+/* Collision model (Koshizuka lab's MPS codes): particle i (in movable)
+ * and each neighbour j closer than the view's radius that it approaches
+ * exchange momentum with restitution e, j taking the share rho_j/(rho_i +
+ * rho_j) (rho NULL: 1/2), or all of it when j is not movable (a fixed wall
+ * is infinitely heavy). Neighbours one after another in the view's order,
+ * from vel_i; the new velocity of i into out (3 per particle; the movable
+ * particles only). */
+void mf_collision(const mf_pairs *v, const uint8_t *movable, const double *rho, double e,
+                  const double *vel, double *out);
 
 /* eq. 18: flag[i] = 1 where n[i] < beta n0 (free surface), else 0. */
 void mf_free_surface(const double *n, size_t count, double beta, double n0, uint8_t *flag);

@@ -27,7 +27,8 @@
 #define AXIS_MASK (AXIS_LIMIT - 1)
 #define RADIX_BITS 11
 #define RADIX_SIZE (1u << RADIX_BITS)
-#define MAX_ROWS 9
+/* Rows of cells a particle may need: up to 2 reach + 1 = 5 per axis. */
+#define MAX_ROWS 25
 /* Candidate bits allowed per particle, on average, before the fill pass
  * falls back to repeating the distance test (bounds the scratch memory). */
 #define MAX_BIT_WORDS_PER_PARTICLE 16
@@ -60,9 +61,11 @@ static inline double binning_width(double cell_size)
     return cell_size * (1.0 + MF_GRID_CELL_SLACK);
 }
 
-static inline int rows_per_cell(int dim)
+/* Rows stored per cell: (2 reach + 1)^(dim-1). */
+static inline int rows_per_cell(int dim, int reach)
 {
-    return dim == 3 ? 9 : 3;
+    const int w = 2 * reach + 1;
+    return dim == 3 ? w * w : w;
 }
 
 /* Free-and-allocate: contents never need to survive a rebuild, so avoid the

@@ -1,120 +1,358 @@
-/* operators.c: neighbour loops of the MPS operators. The pair physics is in
- * the inline helpers below and in mf_kernel.h; nothing here walks cells. */
+/* operators.c: the MPS operators of mf_operators.h as pair kernels (the
+ * terms of mf_kernel.h) handed to the pair engine (mf_pairs.h). Each
+ * operator is a kernel (one pair into a per-i accumulator) and a row
+ * function (the accumulator into the output: the apply sink); the engine
+ * owns the loops. */
 #include "mf_operators.h"
 
 #include <math.h>
 
-/* r_ij = r_j - r_i and its length. */
-static inline double pair_vector(const double *xi, const double *xj, double d[3])
+/* ---- number density ------------------------------------------------------ */
+
+typedef struct {
+    const mf_pairs *v;
+    const uint8_t *jmask;
+    double *out;
+} nd_ctx;
+
+static inline bool nd_pair(void *acc, const void *ctx, const mf_pair *pr)
 {
-    d[0] = xj[0] - xi[0];
-    d[1] = xj[1] - xi[1];
-    d[2] = xj[2] - xi[2];
-    return sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    const nd_ctx *c = ctx;
+    *(double *)acc += mf_weight(pr->len, c->v->radius);
+    return true;
 }
 
-static inline bool selected(const uint8_t *mask, size_t i) { return !mask || mask[i]; }
-
-void mf_number_density(const mf_particles *p, const mf_nlist *nl, const uint8_t *imask,
-                       const uint8_t *jmask, double *n)
+static void nd_row(const void *ctx, size_t i)
 {
-    const double re = nl->radius;
-    const long np = (long)p->n_owned;
-#pragma omp parallel for schedule(static)
-    for (long i = 0; i < np; i++) {
-        if (!selected(imask, (size_t)i))
-            continue;
-        double sum = 0.0, d[3];
-        for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
-            size_t j = nl->j[k];
-            if (selected(jmask, j))
-                sum += mf_weight(pair_vector(&p->pos[3 * i], &p->pos[3 * j], d), re);
-        }
-        n[i] = sum;
+    const nd_ctx *c = ctx;
+    double sum = 0.0;
+    mf_pairs_row(c->v, i, c->jmask, nd_pair, c, &sum);
+    c->out[i] = sum;
+}
+
+void mf_number_density(const mf_pairs *v, const uint8_t *imask, const uint8_t *jmask,
+                       double *n)
+{
+    const nd_ctx c = {v, jmask, n};
+    mf_pairs_each(v, imask, nd_row, &c);
+}
+
+/* ---- gradient ------------------------------------------------------------ */
+
+typedef struct {
+    const mf_pairs *v;
+    const mf_gradient_opts *o;
+    const uint8_t *jmask;
+    double coef; /* d / n0 */
+    double *out;
+} grad_ctx;
+
+typedef struct {
+    double fhat;
+    double g[3];
+} grad_acc;
+
+/* p_min: the smallest f of the neighbourhood. */
+static inline bool min_pair(void *acc, const void *ctx, const mf_pair *pr)
+{
+    const grad_ctx *c = ctx;
+    double *fhat = acc;
+    const double fj = c->o->f[pr->j];
+    if (fj < *fhat)
+        *fhat = fj;
+    return true;
+}
+
+/* The pair coefficient c_ij of the gradient: 1, a constant, or 1/rho_ij
+ * (a literal at the call sites: each compiles to its own loop). */
+enum { COEF_ONE, COEF_CONSTANT, COEF_RHO };
+
+static inline bool grad_pair(void *acc, const void *ctx, const mf_pair *pr, int mode)
+{
+    const grad_ctx *c = ctx;
+    const mf_gradient_opts *o = c->o;
+    grad_acc *a = acc;
+    if (pr->len <= 0.0)
+        return true; /* coincident particles carry no direction */
+    const double cij = mode == COEF_RHO ? mf_inv_rho_pair(o->rho[pr->i], o->rho[pr->j],
+                                                          o->rho_average)
+                       : mode == COEF_CONSTANT ? o->coef
+                                               : 1.0;
+    const double s =
+        mf_gradient_term(o->f[pr->j] - a->fhat, cij, mf_weight(pr->len, c->v->radius), pr->len);
+    a->g[0] += s * pr->r[0];
+    a->g[1] += s * pr->r[1];
+    a->g[2] += s * pr->r[2];
+    return true;
+}
+
+static inline bool grad_pair_one(void *acc, const void *ctx, const mf_pair *pr)
+{
+    return grad_pair(acc, ctx, pr, COEF_ONE);
+}
+
+static inline bool grad_pair_constant(void *acc, const void *ctx, const mf_pair *pr)
+{
+    return grad_pair(acc, ctx, pr, COEF_CONSTANT);
+}
+
+static inline bool grad_pair_rho(void *acc, const void *ctx, const mf_pair *pr)
+{
+    return grad_pair(acc, ctx, pr, COEF_RHO);
+}
+
+static inline void grad_row(const void *ctx, size_t i, int mode)
+{
+    const grad_ctx *c = ctx;
+    const mf_gradient_opts *o = c->o;
+    grad_acc a = {o->f[i], {0.0, 0.0, 0.0}};
+    if (o->use_min && !(o->own_reference && o->own_reference[i]))
+        mf_pairs_row_r2(c->v, i, c->jmask, min_pair, c, &a.fhat);
+    if (mode == COEF_RHO)
+        mf_pairs_row(c->v, i, c->jmask, grad_pair_rho, c, &a);
+    else if (mode == COEF_CONSTANT)
+        mf_pairs_row(c->v, i, c->jmask, grad_pair_constant, c, &a);
+    else
+        mf_pairs_row(c->v, i, c->jmask, grad_pair_one, c, &a);
+    c->out[3 * i + 0] = c->coef * a.g[0];
+    c->out[3 * i + 1] = c->coef * a.g[1];
+    c->out[3 * i + 2] = c->coef * a.g[2];
+}
+
+static void grad_row_one(const void *ctx, size_t i) { grad_row(ctx, i, COEF_ONE); }
+static void grad_row_constant(const void *ctx, size_t i) { grad_row(ctx, i, COEF_CONSTANT); }
+static void grad_row_rho(const void *ctx, size_t i) { grad_row(ctx, i, COEF_RHO); }
+
+void mf_gradient_ex(const mf_pairs *v, const mf_kernel *k, const mf_gradient_opts *o,
+                    const uint8_t *imask, const uint8_t *jmask, double *out)
+{
+    const grad_ctx c = {v, o, jmask, k->dim / k->n0, out};
+    if (o->rho)
+        mf_pairs_each(v, imask, grad_row_rho, &c);
+    else if (o->coef == 1.0)
+        mf_pairs_each(v, imask, grad_row_one, &c);
+    else
+        mf_pairs_each(v, imask, grad_row_constant, &c);
+}
+
+void mf_gradient(const mf_pairs *v, const mf_kernel *k, const double *f, bool use_min,
+                 const uint8_t *imask, const uint8_t *jmask, double *out)
+{
+    const mf_gradient_opts o = {.f = f, .use_min = use_min, .coef = 1.0};
+    mf_gradient_ex(v, k, &o, imask, jmask, out);
+}
+
+/* ---- Laplacian ----------------------------------------------------------- */
+
+typedef struct {
+    const mf_pairs *v;
+    const uint8_t *jmask;
+    const double *f;
+    int ncomp;
+    double coef;  /* 2d / (lambda n0) */
+    double scale; /* mf_laplacian_add */
+    /* mf_laplacian_mu */
+    const double *mu, *rho;
+    const uint8_t *mu_mask;
+    int mu_average;
+    double *out;
+} lap_ctx;
+
+/* c_ij (f_j - f_i) w for ncomp components (a literal at the call sites);
+ * c_ij = 1, or mu_ij with a pair viscosity. */
+static inline bool lap_pair(void *acc, const void *ctx, const mf_pair *pr, int ncomp, bool mu)
+{
+    const lap_ctx *c = ctx;
+    double *a = acc;
+    const double w = mf_weight(pr->len, c->v->radius);
+    if (w <= 0.0)
+        return true; /* its term is zero */
+    const size_t i = pr->i, j = pr->j;
+    double cij = 1.0;
+    if (mu)
+        cij = c->mu_mask[j] ? mf_mu_pair(c->mu[i], c->mu[j], c->mu_average) : c->mu[i];
+    const double *f = c->f;
+    if (ncomp == 3) { /* written out: the sums stay in registers */
+        a[0] += mf_laplacian_term(cij, f[3 * j] - f[3 * i], w);
+        a[1] += mf_laplacian_term(cij, f[3 * j + 1] - f[3 * i + 1], w);
+        a[2] += mf_laplacian_term(cij, f[3 * j + 2] - f[3 * i + 2], w);
+    } else {
+        a[0] += mf_laplacian_term(cij, f[j] - f[i], w);
+    }
+    return true;
+}
+
+static inline bool lap1_pair(void *acc, const void *ctx, const mf_pair *pr)
+{
+    return lap_pair(acc, ctx, pr, 1, false);
+}
+
+static inline bool lap3_pair(void *acc, const void *ctx, const mf_pair *pr)
+{
+    return lap_pair(acc, ctx, pr, 3, false);
+}
+
+static inline bool lap3_mu_pair(void *acc, const void *ctx, const mf_pair *pr)
+{
+    return lap_pair(acc, ctx, pr, 3, true);
+}
+
+static void lap1_row(const void *ctx, size_t i)
+{
+    const lap_ctx *c = ctx;
+    double a = 0.0;
+    mf_pairs_row(c->v, i, c->jmask, lap1_pair, c, &a);
+    c->out[i] = c->coef * a;
+}
+
+static void lap3_row(const void *ctx, size_t i)
+{
+    const lap_ctx *c = ctx;
+    double a[3] = {0.0, 0.0, 0.0};
+    mf_pairs_row(c->v, i, c->jmask, lap3_pair, c, a);
+    for (int q = 0; q < 3; q++)
+        c->out[3 * i + q] = c->coef * a[q];
+}
+
+static void lap3_add_row(const void *ctx, size_t i)
+{
+    const lap_ctx *c = ctx;
+    double a[3] = {0.0, 0.0, 0.0};
+    mf_pairs_row(c->v, i, c->jmask, lap3_pair, c, a);
+    for (int q = 0; q < 3; q++) {
+        const double lap = c->coef * a[q];
+        c->out[3 * i + q] += c->scale * lap;
     }
 }
 
-void mf_gradient(const mf_particles *p, const mf_nlist *nl, const mf_kernel *kn, const double *f,
-                 bool use_min, const uint8_t *imask, const uint8_t *jmask, double *out)
+static void lap3_mu_row(const void *ctx, size_t i)
 {
-    const double re = nl->radius, coef = kn->dim / kn->n0;
-    const long np = (long)p->n_owned;
-#pragma omp parallel for schedule(static)
-    for (long i = 0; i < np; i++) {
-        if (!selected(imask, (size_t)i))
-            continue;
-        double fi = f[i];
-        if (use_min)
-            for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
-                size_t j = nl->j[k];
-                if (selected(jmask, j) && f[j] < fi)
-                    fi = f[j];
-            }
-        double g[3] = {0.0, 0.0, 0.0}, d[3];
-        for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
-            size_t j = nl->j[k];
-            if (!selected(jmask, j))
-                continue;
-            double r = pair_vector(&p->pos[3 * i], &p->pos[3 * j], d);
-            if (r <= 0.0)
-                continue; /* coincident particles carry no direction */
-            double s = (f[j] - fi) * mf_weight(r, re) / (r * r);
-            g[0] += s * d[0];
-            g[1] += s * d[1];
-            g[2] += s * d[2];
-        }
-        out[3 * i + 0] = coef * g[0];
-        out[3 * i + 1] = coef * g[1];
-        out[3 * i + 2] = coef * g[2];
-    }
+    const lap_ctx *c = ctx;
+    double a[3] = {0.0, 0.0, 0.0};
+    mf_pairs_row(c->v, i, NULL, lap3_mu_pair, c, a);
+    for (int q = 0; q < 3; q++)
+        c->out[3 * i + q] += c->coef * a[q] / c->rho[i];
 }
 
-void mf_laplacian(const mf_particles *p, const mf_nlist *nl, const mf_kernel *kn, const double *f,
-                  int ncomp, const uint8_t *imask, const uint8_t *jmask, double *out)
+static double lap_coef(const mf_kernel *k)
 {
-    const double re = nl->radius, coef = 2.0 * kn->dim / (kn->lambda * kn->n0);
-    const long np = (long)p->n_owned;
-#pragma omp parallel for schedule(static)
-    for (long i = 0; i < np; i++) {
-        if (!selected(imask, (size_t)i))
-            continue;
-        double acc[3] = {0.0, 0.0, 0.0}, d[3];
-        for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
-            size_t j = nl->j[k];
-            if (!selected(jmask, j))
-                continue;
-            double w = mf_weight(pair_vector(&p->pos[3 * i], &p->pos[3 * j], d), re);
-            for (int c = 0; c < ncomp; c++)
-                acc[c] += (f[ncomp * j + c] - f[ncomp * i + c]) * w;
-        }
-        for (int c = 0; c < ncomp; c++)
-            out[ncomp * i + c] = coef * acc[c];
-    }
+    return 2.0 * k->dim / (k->lambda * k->n0);
 }
 
-void mf_divergence(const mf_particles *p, const mf_nlist *nl, const mf_kernel *kn, const double *u,
+void mf_laplacian(const mf_pairs *v, const mf_kernel *k, const double *f, int ncomp,
+                  const uint8_t *imask, const uint8_t *jmask, double *out)
+{
+    const lap_ctx c = {.v = v, .jmask = jmask, .f = f, .ncomp = ncomp, .coef = lap_coef(k),
+                       .out = out};
+    if (ncomp == 3)
+        mf_pairs_each(v, imask, lap3_row, &c);
+    else
+        mf_pairs_each(v, imask, lap1_row, &c);
+}
+
+void mf_laplacian_add(const mf_pairs *v, const mf_kernel *k, const double *f, double scale,
+                      const uint8_t *imask, const uint8_t *jmask, double *out)
+{
+    const lap_ctx c = {.v = v, .jmask = jmask, .f = f, .ncomp = 3, .coef = lap_coef(k),
+                       .scale = scale, .out = out};
+    mf_pairs_each(v, imask, lap3_add_row, &c);
+}
+
+void mf_laplacian_mu(const mf_pairs *v, const mf_kernel *k, const double *f, const double *mu,
+                     int mu_average, const uint8_t *mu_mask, const double *rho,
+                     const uint8_t *imask, double *out)
+{
+    const lap_ctx c = {.v = v, .f = f, .ncomp = 3, .coef = lap_coef(k), .mu = mu, .rho = rho,
+                       .mu_mask = mu_mask, .mu_average = mu_average, .out = out};
+    mf_pairs_each(v, imask, lap3_mu_row, &c);
+}
+
+/* ---- divergence ---------------------------------------------------------- */
+
+typedef struct {
+    const mf_pairs *v;
+    const uint8_t *jmask;
+    const double *u;
+    double coef;
+    double *out;
+} div_ctx;
+
+static inline bool div_pair(void *acc, const void *ctx, const mf_pair *pr)
+{
+    const div_ctx *c = ctx;
+    if (pr->len <= 0.0)
+        return true;
+    const double *ui = c->u + 3 * pr->i, *uj = c->u + 3 * pr->j;
+    const double du = (uj[0] - ui[0]) * pr->r[0] + (uj[1] - ui[1]) * pr->r[1] +
+                      (uj[2] - ui[2]) * pr->r[2];
+    *(double *)acc += mf_divergence_term(du, mf_weight(pr->len, c->v->radius), pr->len);
+    return true;
+}
+
+static void div_row(const void *ctx, size_t i)
+{
+    const div_ctx *c = ctx;
+    double sum = 0.0;
+    mf_pairs_row(c->v, i, c->jmask, div_pair, c, &sum);
+    c->out[i] = c->coef * sum;
+}
+
+void mf_divergence(const mf_pairs *v, const mf_kernel *k, const double *u,
                    const uint8_t *imask, const uint8_t *jmask, double *out)
 {
-    const double re = nl->radius, coef = kn->dim / kn->n0;
-    const long np = (long)p->n_owned;
-#pragma omp parallel for schedule(static)
-    for (long i = 0; i < np; i++) {
-        if (!selected(imask, (size_t)i))
-            continue;
-        double sum = 0.0, d[3];
-        for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
-            size_t j = nl->j[k];
-            if (!selected(jmask, j))
-                continue;
-            double r = pair_vector(&p->pos[3 * i], &p->pos[3 * j], d);
-            if (r <= 0.0)
-                continue;
-            double du = (u[3 * j] - u[3 * i]) * d[0] + (u[3 * j + 1] - u[3 * i + 1]) * d[1] +
-                        (u[3 * j + 2] - u[3 * i + 2]) * d[2];
-            sum += du * mf_weight(r, re) / (r * r);
-        }
-        out[i] = coef * sum;
-    }
+    const div_ctx c = {v, jmask, u, k->dim / k->n0, out};
+    mf_pairs_each(v, imask, div_row, &c);
+}
+
+/* ---- collision ----------------------------------------------------------- */
+
+typedef struct {
+    const mf_pairs *v;
+    const uint8_t *movable;
+    const double *rho, *vel;
+    double e;
+    double *out;
+} coll_ctx;
+
+/* One approaching pair: i's velocity (acc) loses the share of j's mass of
+ * (1 + e) times the approach speed along r_ij. */
+static inline bool coll_pair(void *acc, const void *ctx, const mf_pair *pr)
+{
+    const coll_ctx *c = ctx;
+    double *vi = acc;
+    if (pr->r2 <= 0)
+        return true;
+    const double len = pr->len, *vj = c->vel + 3 * pr->j, *r = pr->r;
+    double approach = 0;
+    approach += (vi[0] - vj[0]) * r[0] / len;
+    approach += (vi[1] - vj[1]) * r[1] / len;
+    approach += (vi[2] - vj[2]) * r[2] / len;
+    if (approach <= 0)
+        return true;
+    const size_t i = pr->i, j = pr->j;
+    const double share = !c->movable[j] ? 1.0
+                         : c->rho       ? c->rho[j] / (c->rho[i] + c->rho[j])
+                                        : 0.5;
+    vi[0] -= share * (1 + c->e) * approach * r[0] / len;
+    vi[1] -= share * (1 + c->e) * approach * r[1] / len;
+    vi[2] -= share * (1 + c->e) * approach * r[2] / len;
+    return true;
+}
+
+static void coll_row(const void *ctx, size_t i)
+{
+    const coll_ctx *c = ctx;
+    double vi[3] = {c->vel[3 * i], c->vel[3 * i + 1], c->vel[3 * i + 2]};
+    mf_pairs_row(c->v, i, NULL, coll_pair, c, vi);
+    for (int q = 0; q < 3; q++)
+        c->out[3 * i + q] = vi[q];
+}
+
+void mf_collision(const mf_pairs *v, const uint8_t *movable, const double *rho, double e,
+                  const double *vel, double *out)
+{
+    const coll_ctx c = {v, movable, rho, vel, e, out};
+    mf_pairs_each(v, movable, coll_row, &c);
 }
 
 void mf_free_surface(const double *n, size_t count, double beta, double n0, uint8_t *flag)

@@ -6,38 +6,51 @@
 
 #include "mf_error.h"
 #include "mf_neighbours.h"
+#include "mf_pairs.h"
 #include "mf_scene.h"
+
+typedef struct overlap_acc {
+    size_t pairs, first_i, first_j;
+} overlap_acc;
+
+/* Each pair once (j > i); the first in (i, list) order is named. */
+static inline bool overlap_pair(void *acc, const void *ctx, const mf_pair *pr)
+{
+    (void)ctx;
+    overlap_acc *a = acc;
+    if (pr->j > pr->i && a->pairs++ == 0) {
+        a->first_i = pr->i;
+        a->first_j = pr->j;
+    }
+    return true;
+}
 
 int mf_scene_check_overlap(const mf_sim *sim)
 {
     const mf_particles *p = sim->p;
     if (p->n < 2)
         return 0;
-    mf_grid g;
-    mf_nlist nl;
-    mf_grid_init(&g);
-    mf_nlist_init(&nl);
     const double radius = 0.5 * sim->l0;
-    int rc = mf_grid_build(&g, p, radius);
+    mf_neighbours *nb = NULL;
+    MF_CALL(mf_neighbours_create(&nb));
+    int h = 0;
+    mf_pairs v;
+    int rc = mf_neighbours_request(nb, radius, radius, &h);
     if (rc == 0)
-        rc = mf_nlist_build(&nl, &g, p, radius);
-    size_t pairs = 0, first_i = 0, first_j = 0;
+        rc = mf_neighbours_pairs(nb, p, h, &v);
+    overlap_acc a = {0, 0, 0};
+    /* Every particle: the scene has no halos yet. */
     for (size_t i = 0; rc == 0 && i < p->n; i++)
-        for (size_t k = nl.start[i]; k < nl.start[i + 1]; k++)
-            if (nl.j[k] > i && pairs++ == 0) {
-                first_i = i;
-                first_j = nl.j[k];
-            }
-    mf_grid_free(&g);
-    mf_nlist_free(&nl);
+        mf_pairs_row_r2(&v, i, NULL, overlap_pair, NULL, &a);
+    mf_neighbours_destroy(nb);
     MF_CALL(rc);
-    if (pairs == 0)
+    if (a.pairs == 0)
         return 0;
-    const double *a = &p->pos[3 * first_i], *b = &p->pos[3 * first_j];
+    const double *x = &p->pos[3 * a.first_i], *y = &p->pos[3 * a.first_j];
     return MF_ERROR(MF_ERR_INPUT,
                     "constant/geometry: %zu pairs of particles start closer than l0/2 = %g m, "
                     "e.g. a %s particle at (%g %g %g) and a %s particle at (%g %g %g): do two "
                     "fluid blocks overlap, or does a block reach into a wall?",
-                    pairs, radius, mf_particle_kind_name(p->kind[first_i]), a[0], a[1], a[2],
-                    mf_particle_kind_name(p->kind[first_j]), b[0], b[1], b[2]);
+                    a.pairs, radius, mf_particle_kind_name(p->kind[a.first_i]), x[0], x[1], x[2],
+                    mf_particle_kind_name(p->kind[a.first_j]), y[0], y[1], y[2]);
 }

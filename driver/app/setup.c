@@ -203,6 +203,7 @@ int mf_app_setup(mf_app *app)
         app->log.progress = false; /* mpirun hands rank 0 a terminal even into a file */
     sim->log = &app->log;
     sim->reg = app->reg;
+    MF_CALL(mf_neighbours_create(&sim->neighbours));
     MF_CALL(mf_case_read(app->opt.case_dir, &app->cs));
     MF_CALL(mf_app_create_parallel(app, app->cs.resolved));
     /* One rank looks at (and with -overwrite clears) output/: the others
@@ -291,6 +292,8 @@ void mf_app_teardown(mf_app *app)
     mf_emitters_destroy(app->sim.emitters);
     app->sim.emitters = NULL;
     mf_particles_destroy(app->sim.p);
+    mf_neighbours_destroy(app->sim.neighbours);
+    app->sim.neighbours = NULL;
     mf_parallel_destroy(app->sim.par);
     app->sim.par = NULL;
     mf_case_free(&app->cs);

@@ -11,7 +11,7 @@
 
 #include "mf_error.h"
 #include "mf_hdf5.h"
-#include "mf_neighbours.h"
+#include "mf_pairs.h"
 #include "mf_post.h"
 #include "mf_report.h"
 
@@ -35,25 +35,34 @@ static const mf_param front_params[] = {
 };
 static const char *const front_extra[] = {"FoamFile", NULL};
 
+/* Counts i's neighbours, stopping at two. */
+static inline bool count_two(void *acc, const void *ctx, const mf_pair *pr)
+{
+    (void)ctx;
+    (void)pr;
+    return ++*(int *)acc < 2;
+}
+
 int mf_front_of_particles(const mf_particles *fluid, double l0, double back_wall, double *z)
 {
-    mf_grid g;
-    mf_nlist nl;
-    mf_grid_init(&g);
-    mf_nlist_init(&nl);
     const double radius = 2.1 * l0;
-    int rc = 0;
     *z = 0;
-    if (fluid->n > 0) {
-        rc = mf_grid_build(&g, fluid, radius);
-        if (rc == 0)
-            rc = mf_nlist_build(&nl, &g, fluid, radius);
-        for (size_t i = 0; rc == 0 && i < fluid->n; i++)
-            if (nl.start[i + 1] - nl.start[i] >= 2 && fluid->pos[3 * i] - back_wall > *z)
-                *z = fluid->pos[3 * i] - back_wall;
+    if (fluid->n == 0)
+        return 0;
+    mf_neighbours *nb = NULL;
+    MF_CALL(mf_neighbours_create(&nb));
+    int h = 0;
+    mf_pairs v;
+    int rc = mf_neighbours_request(nb, radius, radius, &h);
+    if (rc == 0)
+        rc = mf_neighbours_pairs(nb, fluid, h, &v);
+    for (size_t i = 0; rc == 0 && i < fluid->n; i++) {
+        int count = 0;
+        mf_pairs_row_r2(&v, i, NULL, count_two, NULL, &count);
+        if (count >= 2 && fluid->pos[3 * i] - back_wall > *z)
+            *z = fluid->pos[3 * i] - back_wall;
     }
-    mf_grid_free(&g);
-    mf_nlist_free(&nl);
+    mf_neighbours_destroy(nb);
     return rc;
 }
 

@@ -14,7 +14,7 @@
 #include "forces.h"
 #include "mf_error.h"
 #include "mf_kernel.h"
-#include "mf_neighbours.h"
+#include "mf_pairs.h"
 
 typedef struct drag_settings {
     double cd, alpha, diameter, radius;
@@ -39,8 +39,7 @@ typedef struct drag_data {
     drag_settings s;
     double coef; /* 3 C_D alpha / (4 d_p) */
     double re;   /* m */
-    mf_grid grid;
-    mf_nlist nl;
+    int pairs;   /* neighbour request (sim->neighbours) */
 } drag_data;
 
 /* eq. 40 for one particle: the acceleration toward the neighbourhood's velocity. */
@@ -53,12 +52,7 @@ static inline void drag_law(double coef, const double du[3], double out[3])
 
 static void drag_destroy(void *data)
 {
-    drag_data *d = data;
-    if (!d)
-        return;
-    mf_grid_free(&d->grid);
-    mf_nlist_free(&d->nl);
-    free(d);
+    free(data);
 }
 
 static int drag_create(const void *settings, mf_sim *sim, void **data)
@@ -69,8 +63,12 @@ static int drag_create(const void *settings, mf_sim *sim, void **data)
     d->s = *(const drag_settings *)settings;
     d->coef = 3.0 * d->s.cd * d->s.alpha / (4.0 * d->s.diameter * sim->l0);
     d->re = d->s.radius * sim->l0;
-    mf_grid_init(&d->grid);
-    mf_nlist_init(&d->nl);
+    /* Shared: the solver's lists where they reach (their order, too). */
+    int rc = mf_neighbours_request(sim->neighbours, d->re, 0, &d->pairs);
+    if (rc != 0) {
+        free(d);
+        return mf_error_trace(rc, __FILE__, __LINE__, __func__);
+    }
     mf_log_printf(sim->log, MF_LOG_NORMAL,
                   "drag: C_D = %g, alpha = %g, d_p = %g m, u_bar within %g l0%s\n", d->s.cd,
                   d->s.alpha, d->s.diameter * sim->l0, d->s.radius,
@@ -79,48 +77,59 @@ static int drag_create(const void *settings, mf_sim *sim, void **data)
     return 0;
 }
 
+typedef struct drag_ctx {
+    const drag_data *d;
+    const mf_particles *p;
+    const mf_pairs *v;
+    double *acc;
+} drag_ctx;
+
+typedef struct drag_acc {
+    double sw, su[3];
+} drag_acc;
+
+/* eq. 41's sums: w and w u_j over the fluid (and wall) neighbours. */
+static inline bool drag_pair(void *acc, const void *ctx, const mf_pair *pr)
+{
+    const drag_ctx *c = ctx;
+    drag_acc *a = acc;
+    const mf_particles *p = c->p;
+    const bool fluid = p->kind[pr->j] == MF_FLUID;
+    if (!fluid && !(c->d->s.walls && p->kind[pr->j] == MF_WALL))
+        return true;
+    const double w = mf_weight(pr->len, c->d->re);
+    a->sw += w;
+    if (fluid)
+        for (int q = 0; q < 3; q++)
+            a->su[q] += w * p->vel[3 * pr->j + q];
+    return true;
+}
+
+static void drag_row(const void *ctx, size_t i)
+{
+    const drag_ctx *c = ctx;
+    const mf_particles *p = c->p;
+    if (p->kind[i] != MF_FLUID)
+        return;
+    drag_acc a = {0, {0, 0, 0}};
+    mf_pairs_row(c->v, i, NULL, drag_pair, c, &a);
+    if (!(a.sw > 0))
+        return;
+    double du[3], f[3];
+    for (int q = 0; q < 3; q++)
+        du[q] = a.su[q] / a.sw - p->vel[3 * i + q]; /* eq. 41: u_bar - u */
+    drag_law(c->d->coef, du, f);
+    for (int q = 0; q < 3; q++)
+        c->acc[3 * i + q] += f[q];
+}
+
 static int drag_accumulate(void *data, const mf_sim *sim, double *acc)
 {
     drag_data *d = data;
-    const mf_particles *p = sim->p;
-    const mf_nlist *nl = sim->neighbours;
-    if (!nl || nl->radius < d->re || nl->n < p->n_owned) {
-        MF_CALL(mf_grid_build(&d->grid, p, d->re));
-        MF_CALL(mf_nlist_build(&d->nl, &d->grid, p, d->re));
-        nl = &d->nl;
-    }
-    const double re = d->re;
-    const long np = (long)p->n_owned;
-#pragma omp parallel for schedule(static)
-    for (long i = 0; i < np; i++) {
-        if (p->kind[i] != MF_FLUID)
-            continue;
-        double sw = 0, su[3] = {0, 0, 0};
-        for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
-            size_t j = nl->j[k];
-            bool fluid = p->kind[j] == MF_FLUID;
-            if (!fluid && !(d->s.walls && p->kind[j] == MF_WALL))
-                continue;
-            double r2 = 0;
-            for (int c = 0; c < 3; c++) {
-                double dx = p->pos[3 * j + c] - p->pos[3 * i + c];
-                r2 += dx * dx;
-            }
-            double w = mf_weight(sqrt(r2), re);
-            sw += w;
-            if (fluid)
-                for (int c = 0; c < 3; c++)
-                    su[c] += w * p->vel[3 * j + c];
-        }
-        if (!(sw > 0))
-            continue;
-        double du[3], a[3];
-        for (int c = 0; c < 3; c++)
-            du[c] = su[c] / sw - p->vel[3 * i + c]; /* eq. 41: u_bar - u */
-        drag_law(d->coef, du, a);
-        for (int c = 0; c < 3; c++)
-            acc[3 * i + c] += a[c];
-    }
+    mf_pairs v;
+    MF_CALL(mf_neighbours_pairs(sim->neighbours, sim->p, d->pairs, &v));
+    const drag_ctx c = {d, sim->p, &v, acc};
+    mf_pairs_each(&v, NULL, drag_row, &c);
     return 0;
 }
 

@@ -72,7 +72,7 @@
 #include "mf_error.h"
 #include "mf_halo.h"
 #include "mf_kernel.h"
-#include "mf_neighbours.h"
+#include "mf_pairs.h"
 #include "mf_scene.h"
 
 typedef struct st_settings {
@@ -131,8 +131,7 @@ typedef struct st_data {
     double table_f[EXACT_TABLE];
     int f_curvature;           /* Curvature field */
     int f_accel;               /* SurfaceTension field: f_st / rho_x, m/s^2 */
-    mf_grid grid;
-    mf_nlist nl;               /* own list when the solver's is too short */
+    int pairs;                 /* neighbour request within r_st (sim->neighbours) */
     size_t cap;
     int32_t *n1, *nall;
     double *kappa, *kappa_s, *fdir;
@@ -309,8 +308,6 @@ static void st_destroy(void *data)
     st_data *d = data;
     if (!d)
         return;
-    mf_grid_free(&d->grid);
-    mf_nlist_free(&d->nl);
     free(d->n1);
     free(d->nall);
     free(d->kappa);
@@ -330,8 +327,8 @@ static int st_create_data(const st_settings *s, mf_sim *sim, st_data *d)
     d->dim = sim->dim;
     d->l0 = sim->l0;
     d->r = s->radius * sim->l0;
-    mf_grid_init(&d->grid);
-    mf_nlist_init(&d->nl);
+    /* Shared: the solver's lists where they reach r_st (their order, too). */
+    MF_CALL(mf_neighbours_request(sim->neighbours, d->r, 0, &d->pairs));
     lattice_counts(d);
     for (int i = 0; i < EXACT_TABLE; i++)
         d->table_f[i] = disk_fraction(2.0 * i / (EXACT_TABLE - 1));
@@ -387,28 +384,6 @@ static int sync(const mf_sim *sim, void *values, size_t size)
     return 0;
 }
 
-/* Neighbours within r_st: the solver's list when it reaches, else our own. */
-static int neighbours(st_data *d, const mf_sim *sim, const mf_nlist **out)
-{
-    if (sim->neighbours && sim->neighbours->radius >= d->r &&
-        sim->neighbours->n >= sim->p->n_owned) {
-        *out = sim->neighbours;
-        return 0;
-    }
-    MF_CALL(mf_grid_build(&d->grid, sim->p, d->r));
-    MF_CALL(mf_nlist_build(&d->nl, &d->grid, sim->p, d->r));
-    *out = &d->nl;
-    return 0;
-}
-
-static inline double dist(const double *xi, const double *xj, double r[3])
-{
-    r[0] = xj[0] - xi[0];
-    r[1] = xj[1] - xi[1];
-    r[2] = xj[2] - xi[2];
-    return sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
-}
-
 static inline int fluid_of(const int32_t *fid, size_t i) { return fid ? fid[i] : 0; }
 
 /* Same fluid as x (walls and dummies count as every fluid's own). */
@@ -450,30 +425,62 @@ static int reserve(st_data *d, size_t n)
     return 0;
 }
 
+/* What the loops below share: the pairs within r_st and the fields. */
+typedef struct st_ctx {
+    st_data *d;
+    const mf_particles *p;
+    const int32_t *fid;
+    const mf_pairs *v;
+    double n_full, thr;
+    const double *kin; /* curvature smoothing: the pass's input */
+    double *kout;
+    const double *kap; /* the force and the surface pressure: the curvature */
+    double *acc, *accel_out, *kappa_out;
+    const mf_sim *sim;
+} st_ctx;
+
 /* eqs. 34-35: n^st1 (own fluid, walls included) and the count of every
  * particle within r_st. */
-static void count_neighbours(st_data *d, const mf_particles *p, const int32_t *fid,
-                             const mf_nlist *nl)
+typedef struct count_acc {
+    int x;
+    int32_t own_count, all;
+} count_acc;
+
+static inline bool count_pair(void *acc, const void *ctx, const mf_pair *pr)
 {
-    const double rst = d->r;
-    const long np = (long)p->n_owned;
-#pragma omp parallel for schedule(static)
-    for (long i = 0; i < np; i++) {
-        int32_t own_count = 0, all = 0;
-        if (p->kind[i] == MF_FLUID) {
-            int x = fluid_of(fid, (size_t)i);
-            double r[3];
-            for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
-                size_t j = nl->j[k];
-                if (dist(&p->pos[3 * i], &p->pos[3 * j], r) >= rst)
-                    continue;
-                all++;
-                own_count += own(p, fid, j, x);
-            }
-        }
-        d->n1[i] = own_count;
-        d->nall[i] = all;
+    const st_ctx *c = ctx;
+    count_acc *a = acc;
+    if (pr->len >= c->d->r)
+        return true;
+    a->all++;
+    a->own_count += own(c->p, c->fid, pr->j, a->x);
+    return true;
+}
+
+static void count_row(const void *ctx, size_t i)
+{
+    const st_ctx *c = ctx;
+    count_acc a = {0, 0, 0};
+    if (c->p->kind[i] == MF_FLUID) {
+        a.x = fluid_of(c->fid, i);
+        mf_pairs_row(c->v, i, NULL, count_pair, c, &a);
     }
+    c->d->n1[i] = a.own_count;
+    c->d->nall[i] = a.all;
+}
+
+static void count_neighbours(const st_ctx *c)
+{
+    mf_pairs_each(c->v, NULL, count_row, c);
+}
+
+/* A neighbour within r_st that misses neighbours (ends the row). */
+static inline bool deep_pair(void *acc, const void *ctx, const mf_pair *pr)
+{
+    const st_ctx *c = ctx;
+    bool *deep = acc;
+    *deep = !(c->p->kind[pr->j] == MF_FLUID && c->d->nall[pr->j] < c->thr && pr->len < c->d->r);
+    return *deep;
 }
 
 /* The full count of the current packing: the mean count of the fluid
@@ -482,99 +489,89 @@ static void count_neighbours(st_data *d, const mf_particles *p, const int32_t *f
  * Disorder changes the count by a particle or two out of 30, which the
  * curvature of eqs. 38-39 would read as 0.05 / l0; a count-based choice of
  * the particles (count above a threshold) would be biased the same way. */
-static double measured_full_count(const st_data *d, const mf_particles *p, const mf_nlist *nl)
+static double measured_full_count(st_ctx *c)
 {
-    const double thr = d->s.beta * d->n_full, rst = d->r;
-    double sum = 0, count = 0;
+    const st_data *d = c->d;
+    const mf_particles *p = c->p;
+    c->thr = d->s.beta * d->n_full;
+    double sum = 0;
+    size_t count = 0;
     for (size_t i = 0; i < p->n_owned; i++) {
-        if (p->kind[i] != MF_FLUID || d->nall[i] < thr)
+        if (p->kind[i] != MF_FLUID || d->nall[i] < c->thr)
             continue;
         bool deep = true;
-        double r[3];
-        for (size_t k = nl->start[i]; k < nl->start[i + 1] && deep; k++) {
-            size_t j = nl->j[k];
-            deep = !(p->kind[j] == MF_FLUID && d->nall[j] < thr &&
-                     dist(&p->pos[3 * i], &p->pos[3 * j], r) < rst);
-        }
+        mf_pairs_row(c->v, i, NULL, deep_pair, c, &deep);
         if (deep) {
             sum += d->nall[i];
             count++;
         }
     }
-    return count ? sum / count : d->n_full;
+    double v[2] = {sum, (double)count}; /* over the ranks */
+    mf_parallel_sum(c->sim->par, v, 2);
+    return v[1] > 0 ? v[0] / v[1] : d->n_full;
 }
 
-/* The same over every rank. */
-static double global_full_count(const st_data *d, const mf_sim *sim, const mf_nlist *nl)
+static void copy_mark_row(const void *ctx, size_t i)
 {
-    if (!sim->par)
-        return measured_full_count(d, sim->p, nl);
-    const double thr = d->s.beta * d->n_full, rst = d->r;
-    const mf_particles *p = sim->p;
-    double v[2] = {0, 0};
-    for (size_t i = 0; i < p->n_owned; i++) {
-        if (p->kind[i] != MF_FLUID || d->nall[i] < thr)
-            continue;
-        bool deep = true;
-        double r[3];
-        for (size_t k = nl->start[i]; k < nl->start[i + 1] && deep; k++) {
-            size_t j = nl->j[k];
-            deep = !(p->kind[j] == MF_FLUID && d->nall[j] < thr &&
-                     dist(&p->pos[3 * i], &p->pos[3 * j], r) < rst);
-        }
-        if (deep) {
-            v[0] += d->nall[i];
-            v[1]++;
-        }
+    const st_ctx *c = ctx;
+    c->d->kappa_s[i] = c->d->fdir[3 * i];
+}
+
+typedef struct normal_acc {
+    int x;
+    double m[3];
+} normal_acc;
+
+static inline bool normal_pair(void *acc, const void *ctx, const mf_pair *pr)
+{
+    const st_ctx *c = ctx;
+    normal_acc *a = acc;
+    const size_t j = pr->j;
+    if (c->p->kind[j] != MF_FLUID)
+        return true;
+    const double len = pr->len, rst = c->d->r;
+    if (len >= rst || len <= 0)
+        return true;
+    double w = colour_weight(len, rst) * (fluid_of(c->fid, j) == a->x ? 1.0 : -1.0);
+    for (int q = 0; q < 3; q++)
+        a->m[q] += w * c->d->nrm[3 * j + q];
+    return true;
+}
+
+static void normal_row(const void *ctx, size_t i)
+{
+    const st_ctx *c = ctx;
+    st_data *d = c->d;
+    const double *ni = &d->nrm[3 * i];
+    normal_acc a = {0, {ni[0], ni[1], ni[2]}};
+    if (a.m[0] != 0 || a.m[1] != 0 || a.m[2] != 0) {
+        a.x = fluid_of(c->fid, i);
+        mf_pairs_row(c->v, i, NULL, normal_pair, c, &a);
+        double len = sqrt(a.m[0] * a.m[0] + a.m[1] * a.m[1] + a.m[2] * a.m[2]);
+        for (int q = 0; q < 3; q++)
+            a.m[q] = len > 0 ? a.m[q] / len : 0.0;
     }
-    mf_parallel_sum(sim->par, v, 2);
-    return v[1] ? v[0] / v[1] : d->n_full;
+    for (int q = 0; q < 3; q++)
+        d->fdir[3 * i + q] = a.m[q];
 }
 
 /* The normals averaged over the interface particles within r_st (weight
  * psi, another fluid's normal reversed) and renormalised: on a lattice the
  * raw normals follow the staircase of the particle rows, whose divergence
  * is noise of the order of 1 / l0. kappa_s is the scratch copy. */
-static void smooth_normals(st_data *d, const mf_particles *p, const int32_t *fid,
-                           const mf_nlist *nl)
+static void smooth_normals(const st_ctx *c)
 {
-    const double rst = d->r;
-    const long np = (long)p->n_owned;
+    st_data *d = c->d;
+    const long np = (long)c->p->n_owned;
     double *out = d->fdir; /* fdir[3i] (free-surface mark) is saved below */
     double *mark = d->kappa_s;
-#pragma omp parallel for schedule(dynamic, 64)
+    mf_pairs_each(c->v, NULL, copy_mark_row, c);
+    mf_pairs_each(c->v, NULL, normal_row, c);
     for (long i = 0; i < np; i++) {
-        mark[i] = d->fdir[3 * i];
-    }
-#pragma omp parallel for schedule(dynamic, 64)
-    for (long i = 0; i < np; i++) {
-        const double *ni = &d->nrm[3 * i];
-        double m[3] = {ni[0], ni[1], ni[2]}, r[3];
-        if (m[0] != 0 || m[1] != 0 || m[2] != 0) {
-            const int x = fluid_of(fid, (size_t)i);
-            for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
-                size_t j = nl->j[k];
-                if (p->kind[j] != MF_FLUID)
-                    continue;
-                double len = dist(&p->pos[3 * i], &p->pos[3 * j], r);
-                if (len >= rst || len <= 0)
-                    continue;
-                double w = colour_weight(len, rst) * (fluid_of(fid, j) == x ? 1.0 : -1.0);
-                for (int c = 0; c < 3; c++)
-                    m[c] += w * d->nrm[3 * j + c];
-            }
-            double len = sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
-            for (int c = 0; c < 3; c++)
-                m[c] = len > 0 ? m[c] / len : 0.0;
-        }
-        for (int c = 0; c < 3; c++)
-            out[3 * i + c] = m[c];
-    }
-    for (long i = 0; i < np; i++) {
-        for (int c = 0; c < 3; c++) {
-            double t = d->nrm[3 * i + c];
-            d->nrm[3 * i + c] = out[3 * i + c];
-            out[3 * i + c] = t;
+        for (int q = 0; q < 3; q++) {
+            double t = d->nrm[3 * i + q];
+            d->nrm[3 * i + q] = out[3 * i + q];
+            out[3 * i + q] = t;
         }
         out[3 * i] = mark[i];
     }
@@ -612,6 +609,63 @@ static bool invert_sym(int dim, const double m[3][3], double inv[3][3])
     return true;
 }
 
+typedef struct div_acc {
+    int x;
+    const double *ni;
+    double A[3][3], M[3][3];
+} div_acc;
+
+static inline bool div_pair(void *acc, const void *ctx, const mf_pair *pr)
+{
+    const st_ctx *c = ctx;
+    div_acc *a = acc;
+    const size_t j = pr->j;
+    if (c->p->kind[j] != MF_FLUID)
+        return true;
+    const double *nj = &c->d->nrm[3 * j];
+    if (nj[0] == 0 && nj[1] == 0 && nj[2] == 0)
+        return true;
+    const double len = pr->len, rst = c->d->r, *r = pr->r;
+    if (len >= rst || len <= 0)
+        return true;
+    double sign = fluid_of(c->fid, j) == a->x ? 1.0 : -1.0;
+    double w = colour_weight(len, rst) / (len * len);
+    const int dim = c->d->dim;
+    for (int q = 0; q < dim; q++)
+        for (int b = 0; b < dim; b++) {
+            a->A[q][b] += w * (sign * nj[q] - a->ni[q]) * r[b];
+            a->M[q][b] += w * r[q] * r[b];
+        }
+    return true;
+}
+
+static void div_row(const void *ctx, size_t i)
+{
+    const st_ctx *c = ctx;
+    st_data *d = c->d;
+    if (isnan(d->kappa[i]))
+        return;
+    const double *ni = &d->nrm[3 * i];
+    if (ni[0] == 0 && ni[1] == 0 && ni[2] == 0) {
+        d->kappa[i] = 0;
+        return;
+    }
+    div_acc a = {fluid_of(c->fid, i), ni, {{0}}, {{0}}};
+    mf_pairs_row(c->v, i, NULL, div_pair, c, &a);
+    const int dim = d->dim;
+    const double rst = d->r;
+    double inv[3][3];
+    double kappa = 0;
+    if (invert_sym(dim, a.M, inv))
+        for (int q = 0; q < dim; q++)
+            for (int b = 0; b < dim; b++)
+                kappa += a.A[q][b] * inv[b][q];
+    /* A particle cannot resolve a radius below r_st / 2 (the count
+     * models' limit too): a corner's normals would ask for more. */
+    const double kmax = (dim == 3 ? 4.0 : 2.0) / rst;
+    d->kappa[i] = fmax(-kmax, fmin(kmax, kappa));
+}
+
 /* curvature normal: kappa = div n (n the outward unit normal; Brackbill et
  * al. 1992) from the MPS gradient (eq. 5) of n over the neighbours that
  * have a normal, corrected by the moment matrix of those neighbours,
@@ -621,53 +675,52 @@ static bool invert_sym(int dim, const double m[3][3], double inv[3][3])
  * curvature there). A particle of another fluid contributes minus its normal
  * (the same interface seen from the other side). Insensitive to a change of
  * the particle density, which moves the counts of eq. 39. */
-static void normal_divergence(st_data *d, const mf_particles *p, const int32_t *fid,
-                              const mf_nlist *nl)
+static void normal_divergence(const st_ctx *c)
 {
-    const double rst = d->r;
-    const int dim = d->dim;
-    const long np = (long)p->n_owned;
-    const double *nv = d->nrm;
-#pragma omp parallel for schedule(dynamic, 64)
-    for (long i = 0; i < np; i++) {
-        if (isnan(d->kappa[i]))
-            continue;
-        const double *ni = &nv[3 * i];
-        if (ni[0] == 0 && ni[1] == 0 && ni[2] == 0) {
-            d->kappa[i] = 0;
-            continue;
-        }
-        const int x = fluid_of(fid, (size_t)i);
-        double A[3][3] = {{0}}, M[3][3] = {{0}}, r[3];
-        for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
-            size_t j = nl->j[k];
-            if (p->kind[j] != MF_FLUID)
-                continue;
-            const double *nj = &nv[3 * j];
-            if (nj[0] == 0 && nj[1] == 0 && nj[2] == 0)
-                continue;
-            double len = dist(&p->pos[3 * i], &p->pos[3 * j], r);
-            if (len >= rst || len <= 0)
-                continue;
-            double sign = fluid_of(fid, j) == x ? 1.0 : -1.0;
-            double w = colour_weight(len, rst) / (len * len);
-            for (int a = 0; a < dim; a++)
-                for (int b = 0; b < dim; b++) {
-                    A[a][b] += w * (sign * nj[a] - ni[a]) * r[b];
-                    M[a][b] += w * r[a] * r[b];
-                }
-        }
-        double inv[3][3];
-        double kappa = 0;
-        if (invert_sym(dim, M, inv))
-            for (int a = 0; a < dim; a++)
-                for (int b = 0; b < dim; b++)
-                    kappa += A[a][b] * inv[b][a];
-        /* A particle cannot resolve a radius below r_st / 2 (the count
-         * models' limit too): a corner's normals would ask for more. */
-        const double kmax = (dim == 3 ? 4.0 : 2.0) / rst;
-        d->kappa[i] = fmax(-kmax, fmin(kmax, kappa));
+    mf_pairs_each(c->v, NULL, div_row, c);
+}
+
+typedef struct mean_kappa_acc {
+    int x;
+    double sw, sk;
+} mean_kappa_acc;
+
+static inline bool surface_kappa_pair(void *acc, const void *ctx, const mf_pair *pr)
+{
+    const st_ctx *c = ctx;
+    mean_kappa_acc *a = acc;
+    const size_t j = pr->j;
+    const st_data *d = c->d;
+    if (c->p->kind[j] != MF_FLUID || d->fdir[3 * j] == 0 || isnan(c->kap[j]) ||
+        fluid_of(c->fid, j) != a->x)
+        return true;
+    const double len = pr->len, rst = d->r;
+    if (len >= rst)
+        return true;
+    a->sw += 1 - len / rst;
+    a->sk += (1 - len / rst) * c->kap[j];
+    return true;
+}
+
+static void surface_pressure_row(const void *ctx, size_t i)
+{
+    const st_ctx *c = ctx;
+    st_data *d = c->d;
+    d->p_surface[i] = NAN;
+    if (c->p->kind[i] != MF_FLUID)
+        return;
+    const int x = fluid_of(c->fid, i);
+    const double sig = d->sigma[x][x];
+    if (!(sig > 0))
+        return;
+    if (d->fdir[3 * i] != 0 && !isnan(c->kap[i])) {
+        d->p_surface[i] = sig * c->kap[i];
+        return;
     }
+    mean_kappa_acc a = {x, 0, 0};
+    mf_pairs_row(c->v, i, NULL, surface_kappa_pair, c, &a);
+    if (a.sw > 0)
+        d->p_surface[i] = sig * a.sk / a.sw;
 }
 
 /* freeSurface pressure: the Laplace pressure sigma_x kappa of every fluid
@@ -677,40 +730,149 @@ static void normal_divergence(st_data *d, const mf_particles *p, const int32_t *
  * other particle the mean of those within r_st (weight 1 - r/r_st): the
  * solver's free surface (n* < beta n0 at r*) is not exactly the one found
  * here (a count within r_st at r^n). NAN where there is none. */
-static void surface_pressure(st_data *d, const mf_particles *p, const int32_t *fid,
-                             const mf_nlist *nl, const double *kap)
+static void surface_pressure(const st_ctx *c)
 {
-    const double rst = d->r;
-    const long np = (long)p->n_owned;
-#pragma omp parallel for schedule(dynamic, 64)
-    for (long i = 0; i < np; i++) {
-        d->p_surface[i] = NAN;
-        if (p->kind[i] != MF_FLUID)
-            continue;
-        const int x = fluid_of(fid, (size_t)i);
-        const double sig = d->sigma[x][x];
-        if (!(sig > 0))
-            continue;
-        if (d->fdir[3 * i] != 0 && !isnan(kap[i])) {
-            d->p_surface[i] = sig * kap[i];
-            continue;
-        }
-        double sw = 0, sk = 0, r[3];
-        for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
-            size_t j = nl->j[k];
-            if (p->kind[j] != MF_FLUID || d->fdir[3 * j] == 0 || isnan(kap[j]) ||
-                fluid_of(fid, j) != x)
-                continue;
-            double len = dist(&p->pos[3 * i], &p->pos[3 * j], r);
-            if (len >= rst)
-                continue;
-            sw += 1 - len / rst;
-            sk += (1 - len / rst) * kap[j];
-        }
-        if (sw > 0)
-            d->p_surface[i] = sig * sk / sw;
+    mf_pairs_each(c->v, NULL, surface_pressure_row, c);
+    c->d->p_surface_n = c->p->n_owned;
+}
+
+/* Interface particles and their curvature (eqs. 36-39); kappa = NAN off the
+ * interface. fdir[3i] = 1 marks a free surface. */
+typedef struct iface_acc {
+    int x;
+    double n2, g[3];
+    bool other;
+} iface_acc;
+
+static inline bool iface_pair(void *acc, const void *ctx, const mf_pair *pr)
+{
+    const st_ctx *c = ctx;
+    iface_acc *a = acc;
+    const st_data *d = c->d;
+    const size_t i = pr->i, j = pr->j;
+    const double len = pr->len, rst = d->r;
+    if (len >= rst || len <= 0)
+        return true;
+    /* colour gradient of the own fluid: toward own, away from others */
+    const bool mine = own(c->p, c->fid, j, a->x);
+    double s = (mine ? 1.0 : -1.0) * colour_weight(len, rst) / len;
+    for (int q = 0; q < 3; q++)
+        a->g[q] += s * pr->r[q];
+    if (mine) {
+        if (c->p->kind[j] != MF_FLUID || d->n1[j] > d->n1[i])
+            a->n2 += 1; /* eq. 37: deeper inside than i */
+        else if (d->n1[j] == d->n1[i])
+            a->n2 += 0.5;
+    } else if (d->sigma[a->x][fluid_of(c->fid, j)] > 0) {
+        a->other = true;
     }
-    d->p_surface_n = (size_t)np;
+    return true;
+}
+
+static void iface_row(const void *ctx, size_t i)
+{
+    const st_ctx *c = ctx;
+    st_data *d = c->d;
+    d->kappa[i] = NAN;
+    d->nrm[3 * i] = d->nrm[3 * i + 1] = d->nrm[3 * i + 2] = 0;
+    if (c->p->kind[i] != MF_FLUID)
+        return;
+    iface_acc a = {fluid_of(c->fid, i), 0, {0, 0, 0}, false};
+    mf_pairs_row(c->v, i, NULL, iface_pair, c, &a);
+    const int x = a.x;
+    const double *g = a.g;
+    bool free_surface = d->nall[i] < d->s.beta * c->n_full && d->sigma[x][x] > 0;
+    d->fdir[3 * i] = free_surface;
+    double gm = d->g_coef * sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+    bool interface = a.other || free_surface;
+    for (int q = 0; q < 3; q++) /* outward: against the colour gradient */
+        d->nrm[3 * i + q] = interface && gm >= 0.1 * d->g_ref ? -d->g_coef * g[q] / gm : 0.0;
+    if (!interface)
+        return;
+    /* eq. 39: n^st2 against its flat-interface value n0^st, half the full
+     * count. Where the probe is full (an interface between fluids), the
+     * particle's own count of every particle is that full count. */
+    double full = free_surface ? c->n_full : (double)d->nall[i];
+    d->kappa[i] = d->normal ? 0.0 : curvature(d, a.n2 / full);
+}
+
+/* One smoothing pass over the free-surface particles (see st_accumulate). */
+typedef struct smooth_acc {
+    int x;
+    double sw, sk;
+} smooth_acc;
+
+static inline bool smooth_pair(void *acc, const void *ctx, const mf_pair *pr)
+{
+    const st_ctx *c = ctx;
+    smooth_acc *a = acc;
+    const size_t j = pr->j;
+    const st_data *d = c->d;
+    if (isnan(c->kin[j]) || d->fdir[3 * j] == 0 || c->p->kind[j] != MF_FLUID ||
+        fluid_of(c->fid, j) != a->x)
+        return true;
+    const double len = pr->len, rst = d->r;
+    if (len >= rst)
+        return true;
+    double w = 1 - len / rst;
+    a->sw += w;
+    a->sk += w * c->kin[j];
+    return true;
+}
+
+static void smooth_row(const void *ctx, size_t i)
+{
+    const st_ctx *c = ctx;
+    c->kout[i] = c->kin[i];
+    if (isnan(c->kin[i]) || c->d->fdir[3 * i] == 0) /* free-surface particles only */
+        return;
+    smooth_acc a = {fluid_of(c->fid, i), 1, c->kin[i]};
+    mf_pairs_row(c->v, i, NULL, smooth_pair, c, &a);
+    c->kout[i] = a.sk / a.sw;
+}
+
+/* sigma kappa delta n of one particle (see st_accumulate). */
+typedef struct force_acc {
+    int x;
+    bool free_surface;
+    double f[3];
+} force_acc;
+
+static inline bool force_pair(void *acc, const void *ctx, const mf_pair *pr)
+{
+    const st_ctx *c = ctx;
+    force_acc *a = acc;
+    const st_data *d = c->d;
+    const size_t i = pr->i, j = pr->j;
+    const double len = pr->len, rst = d->r;
+    if (len >= rst || len <= 0)
+        return true;
+    const int x = a->x;
+    double s = colour_weight(len, rst) / len; /* phi(r) r_hat */
+    double coef = a->free_surface && !d->pressure_mode ? 2 * d->sigma[x][x] * c->kap[i] : 0.0;
+    if (!own(c->p, c->fid, j, x)) {
+        double kj = isnan(c->kap[j]) ? -c->kap[i] : c->kap[j];
+        coef -= d->sigma[x][fluid_of(c->fid, j)] * 0.5 * (c->kap[i] - kj);
+    }
+    for (int q = 0; q < 3; q++)
+        a->f[q] += coef * s * pr->r[q];
+    return true;
+}
+
+static void force_row(const void *ctx, size_t i)
+{
+    const st_ctx *c = ctx;
+    const st_data *d = c->d;
+    if (isnan(c->kap[i]))
+        return;
+    force_acc a = {fluid_of(c->fid, i), d->fdir[3 * i] != 0, {0, 0, 0}};
+    mf_pairs_row(c->v, i, NULL, force_pair, c, &a);
+    const double rho = c->sim->fluid[a.x].rho;
+    for (int q = 0; q < 3; q++) {
+        c->accel_out[3 * i + q] = d->g_coef * a.f[q] / rho;
+        c->acc[3 * i + q] += c->accel_out[3 * i + q];
+    }
+    c->kappa_out[i] = c->kap[i];
 }
 
 static int st_accumulate(void *data, const mf_sim *sim, double *acc)
@@ -730,70 +892,25 @@ static int st_accumulate(void *data, const mf_sim *sim, double *acc)
                         "surface's Dirichlet value, which this solver does not apply (use "
                         "solver multiFluid with one pressure solve per step, or freeSurface "
                         "force)");
-    const mf_nlist *nl = NULL;
-    MF_CALL(neighbours(d, sim, &nl));
+    mf_pairs v;
+    MF_CALL(mf_neighbours_pairs(sim->neighbours, p, d->pairs, &v));
     MF_CALL(reserve(d, p->n));
     int ff = mf_particles_field_index(p, "FluidId");
-    const int32_t *fid = ff >= 0 ? mf_particles_fi(p, ff) : NULL;
-    const double rst = d->r;
-    const long np = (long)p->n_owned;
-    const int32_t *n1 = d->n1;
-    count_neighbours(d, p, fid, nl);
+    st_ctx c = {.d = d, .p = p, .fid = ff >= 0 ? mf_particles_fi(p, ff) : NULL, .v = &v,
+                .acc = acc, .accel_out = accel_out, .kappa_out = kappa_out, .sim = sim};
+    count_neighbours(&c);
     MF_CALL(sync(sim, d->n1, sizeof *d->n1));
     MF_CALL(sync(sim, d->nall, sizeof *d->nall));
-    const double n_full = global_full_count(d, sim, nl);
-    /* Interface particles and their curvature (eqs. 36-39); kappa = NAN
-     * off the interface. fdir[3i] = 1 marks a free surface. */
-#pragma omp parallel for schedule(dynamic, 64)
-    for (long i = 0; i < np; i++) {
-        d->kappa[i] = NAN;
-        d->nrm[3 * i] = d->nrm[3 * i + 1] = d->nrm[3 * i + 2] = 0;
-        if (p->kind[i] != MF_FLUID)
-            continue;
-        const int x = fluid_of(fid, (size_t)i);
-        double n2 = 0, r[3], g[3] = {0, 0, 0};
-        bool other = false;
-        for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
-            size_t j = nl->j[k];
-            double len = dist(&p->pos[3 * i], &p->pos[3 * j], r);
-            if (len >= rst || len <= 0)
-                continue;
-            /* colour gradient of the own fluid: toward own, away from others */
-            double s = (own(p, fid, j, x) ? 1.0 : -1.0) * colour_weight(len, rst) / len;
-            for (int c = 0; c < 3; c++)
-                g[c] += s * r[c];
-            if (own(p, fid, j, x)) {
-                if (p->kind[j] != MF_FLUID || n1[j] > n1[i])
-                    n2 += 1; /* eq. 37: deeper inside than i */
-                else if (n1[j] == n1[i])
-                    n2 += 0.5;
-            } else if (d->sigma[x][fluid_of(fid, j)] > 0) {
-                other = true;
-            }
-        }
-        bool free_surface = d->nall[i] < d->s.beta * n_full && d->sigma[x][x] > 0;
-        d->fdir[3 * i] = free_surface;
-        double gm = d->g_coef * sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
-        bool interface = other || free_surface;
-        for (int c = 0; c < 3; c++) /* outward: against the colour gradient */
-            d->nrm[3 * i + c] =
-                interface && gm >= 0.1 * d->g_ref ? -d->g_coef * g[c] / gm : 0.0;
-        if (!interface)
-            continue;
-        /* eq. 39: n^st2 against its flat-interface value n0^st, half the full
-         * count. Where the probe is full (an interface between fluids), the
-         * particle's own count of every particle is that full count. */
-        double full = free_surface ? n_full : (double)d->nall[i];
-        d->kappa[i] = d->normal ? 0.0 : curvature(d, n2 / full);
-    }
+    c.n_full = measured_full_count(&c);
+    mf_pairs_each(&v, NULL, iface_row, &c);
     MF_CALL(sync(sim, d->nrm, 3 * sizeof *d->nrm));
     MF_CALL(sync(sim, d->fdir, 3 * sizeof *d->fdir));
     MF_CALL(sync(sim, d->kappa, sizeof *d->kappa));
     if (d->normal) {
-        smooth_normals(d, p, fid, nl);
+        smooth_normals(&c);
         MF_CALL(sync(sim, d->nrm, 3 * sizeof *d->nrm));
         MF_CALL(sync(sim, d->fdir, 3 * sizeof *d->fdir));
-        normal_divergence(d, p, fid, nl);
+        normal_divergence(&c);
         MF_CALL(sync(sim, d->kappa, sizeof *d->kappa));
     }
     /* Smoothing (free surfaces): the mean of kappa over the free-surface
@@ -806,27 +923,9 @@ static int st_accumulate(void *data, const mf_sim *sim, double *acc)
      * a lattice drop). */
     double *kin = d->kappa, *kout = d->kappa_s;
     for (long pass = 0; pass < d->s.smoothing; pass++) {
-#pragma omp parallel for schedule(dynamic, 64)
-        for (long i = 0; i < np; i++) {
-            kout[i] = kin[i];
-            if (isnan(kin[i]) || d->fdir[3 * i] == 0) /* free-surface particles only */
-                continue;
-            const int x = fluid_of(fid, (size_t)i);
-            double sw = 1, sk = kin[i], r[3];
-            for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
-                size_t j = nl->j[k];
-                if (isnan(kin[j]) || d->fdir[3 * j] == 0 || p->kind[j] != MF_FLUID ||
-                    fluid_of(fid, j) != x)
-                    continue;
-                double len = dist(&p->pos[3 * i], &p->pos[3 * j], r);
-                if (len >= rst)
-                    continue;
-                double w = 1 - len / rst;
-                sw += w;
-                sk += w * kin[j];
-            }
-            kout[i] = sk / sw;
-        }
+        c.kin = kin;
+        c.kout = kout;
+        mf_pairs_each(&v, NULL, smooth_row, &c);
         MF_CALL(sync(sim, kout, sizeof *kout));
         double *t = kin;
         kin = kout;
@@ -838,37 +937,10 @@ static int st_accumulate(void *data, const mf_sim *sim, double *acc)
      * of an interface carry the same force, half the jump each (unequal
      * shares pull one side off the other and open a gap). A free surface
      * adds 2 sigma_x kappa_i C sum phi r_hat over the particles present. */
-    const double *kap = kin;
-#pragma omp parallel for schedule(dynamic, 64)
-    for (long i = 0; i < np; i++) {
-        if (isnan(kap[i]))
-            continue;
-        const int x = fluid_of(fid, (size_t)i);
-        const bool free_surface = d->fdir[3 * i] != 0;
-        double f[3] = {0, 0, 0}, r[3];
-        for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
-            size_t j = nl->j[k];
-            double len = dist(&p->pos[3 * i], &p->pos[3 * j], r);
-            if (len >= rst || len <= 0)
-                continue;
-            double s = colour_weight(len, rst) / len; /* phi(r) r_hat */
-            double coef = free_surface && !d->pressure_mode ? 2 * d->sigma[x][x] * kap[i] : 0.0;
-            if (!own(p, fid, j, x)) {
-                double kj = isnan(kap[j]) ? -kap[i] : kap[j];
-                coef -= d->sigma[x][fluid_of(fid, j)] * 0.5 * (kap[i] - kj);
-            }
-            for (int c = 0; c < 3; c++)
-                f[c] += coef * s * r[c];
-        }
-        const double rho = sim->fluid[x].rho;
-        for (int c = 0; c < 3; c++) {
-            accel_out[3 * i + c] = d->g_coef * f[c] / rho;
-            acc[3 * i + c] += accel_out[3 * i + c];
-        }
-        kappa_out[i] = kap[i];
-    }
+    c.kap = kin;
+    mf_pairs_each(&v, NULL, force_row, &c);
     if (d->pressure_mode)
-        surface_pressure(d, p, fid, nl, kap);
+        surface_pressure(&c);
     return 0;
 }
 

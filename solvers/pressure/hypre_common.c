@@ -115,7 +115,7 @@ static int check_local(const char *who, const mf_csr *A, const double *b, const 
             return MF_ERROR(MF_ERR_INPUT,
                             "%s: column %" PRId64 " in row %" PRId64 " is outside [0, %" PRId64
                             ") (it must also fit HYPRE_BigInt)",
-                            who, A->col[k], A->row_offset + (int64_t)i, A->nglobal);
+                            who, (int64_t)A->col[k], A->row_offset + (int64_t)i, A->nglobal);
         }
     return 0;
 }

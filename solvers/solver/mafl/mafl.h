@@ -44,6 +44,7 @@
 #include "mf_modules.h"
 #include "mf_halo.h"
 #include "mf_neighbours.h"
+#include "mf_pairs.h"
 #include "solver/mps/mps.h"
 
 typedef enum {
@@ -90,9 +91,9 @@ typedef struct mafl_data {
     int f_scalar[MF_MAX_SCALARS];
     int nscalars;
     double lattice[3];         /* a lattice site: holes are filled on this lattice */
-    /* Neighbour search at r^L (reconfiguration, Eulerian phase) and at
-     * r^{n+1} (point count). */
-    mf_grid grid;
+    /* The neighbour service's grid for point queries (mf_grid_near), at r^L
+     * (reconfiguration, Eulerian phase) and at r^{n+1} (point count). */
+    const mf_grid *grid;
     /* Work arrays, grown as needed. */
     size_t cap;
     double *pos_l;             /* 3n: r^L */
@@ -129,10 +130,6 @@ int mafl_copies(mafl_data *d, mf_sim *sim, double radius, bool values);
 
 /* mafl_lagrangian.c: the Lagrangian phase, the MPS module's step. */
 int mafl_lagrangian(mafl_data *d, mf_sim *sim, double dt);
-
-/* Occupied cells of d->grid whose particles may lie within the grid's cell
- * size of x: up to 27 indices into cells[]; returns how many. */
-int mafl_cells_near(const mf_grid *g, const double x[3], long cells[27]);
 
 /* mafl_reconfigure.c: r^{n+1} into d->pos_new (eqs. 19-20 into the
  * PointVelocity and ConvectionVelocity fields). Needs d->grid at r^L. */

@@ -42,43 +42,60 @@ static inline double carried_at(const carried *cf, int c, size_t j)
     return cf->src[c][(size_t)cf->stride[c] * j];
 }
 
+typedef struct disk_ctx {
+    const carried *cf;
+    const int32_t *kind0;
+    const double *e;  /* the grid's direction */
+    double re, half, exact;
+} disk_ctx;
+
+typedef struct disk_acc {
+    double sum_w, sum[MAFL_MAX_CARRIED];
+    long on_point;    /* a point on the grid point (its values are exact), or -1 */
+} disk_acc;
+
+/* One neighbour of the grid point x in the disk: weight re/r - 1 (eq. 23). */
+static inline bool disk_point(void *acc, const void *ctx, size_t j, const double r[3], double d2)
+{
+    const disk_ctx *c = ctx;
+    disk_acc *a = acc;
+    if (!is_source(c->kind0[j]))
+        return true;
+    double along = r[0] * c->e[0] + r[1] * c->e[1] + r[2] * c->e[2];
+    if (fabs(along) > c->half)
+        return true;
+    double dist = sqrt(d2);
+    if (dist >= c->re)
+        return true;
+    if (dist < c->exact) { /* on the grid point: w is infinite */
+        a->on_point = (long)j;
+        return false;
+    }
+    double w = c->re / dist - 1.0;
+    a->sum_w += w;
+    for (int k = 0; k < c->cf->nc; k++)
+        a->sum[k] += w * carried_at(c->cf, k, j);
+    return true;
+}
+
 /* eq. 23 at x: writes the nc grid values and returns true, or false if the
  * disk holds no point. */
 static bool grid_value(const mafl_data *d, const carried *cf, const int32_t *kind0,
                        const double x[3], const double e[3], double re, double half,
                        double *out)
 {
-    double sum_w = 0, sum[MAFL_MAX_CARRIED] = {0};
-    long cells[27];
-    int ncell = mafl_cells_near(&d->grid, x, cells);
-    const double exact = 1e-9 * re;
-    for (int c = 0; c < ncell; c++)
-        for (size_t m = d->grid.cell_start[cells[c]]; m < d->grid.cell_start[cells[c] + 1]; m++) {
-            size_t j = d->grid.order[m];
-            if (!is_source(kind0[j]))
-                continue;
-            const double *xj = &d->pos_l[3 * j];
-            double r[3] = {xj[0] - x[0], xj[1] - x[1], xj[2] - x[2]};
-            double along = r[0] * e[0] + r[1] * e[1] + r[2] * e[2];
-            if (fabs(along) > half)
-                continue;
-            double dist = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
-            if (dist >= re)
-                continue;
-            if (dist < exact) { /* on the grid point: w is infinite */
-                for (int k = 0; k < cf->nc; k++)
-                    out[k] = carried_at(cf, k, j);
-                return true;
-            }
-            double w = re / dist - 1.0;
-            sum_w += w;
-            for (int k = 0; k < cf->nc; k++)
-                sum[k] += w * carried_at(cf, k, j);
-        }
-    if (!(sum_w > 0))
+    const disk_ctx c = {cf, kind0, e, re, half, 1e-9 * re};
+    disk_acc a = {.sum_w = 0, .on_point = -1};
+    mf_grid_near(d->grid, x, disk_point, &c, &a);
+    if (a.on_point >= 0) {
+        for (int k = 0; k < cf->nc; k++)
+            out[k] = carried_at(cf, k, (size_t)a.on_point);
+        return true;
+    }
+    if (!(a.sum_w > 0))
         return false;
     for (int k = 0; k < cf->nc; k++)
-        out[k] = sum[k] / sum_w;
+        out[k] = a.sum[k] / a.sum_w;
     return true;
 }
 

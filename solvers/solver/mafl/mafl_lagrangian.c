@@ -51,15 +51,52 @@
 #include "mafl.h"
 #include "mf_error.h"
 
-static const mf_nlist *nd_list(const mps_data *m)
-{
-    return m->k_nd.re >= m->nl_max.radius ? &m->nl_max : &m->nl_nd;
-}
-
 /* d/dr w(r) / r for w = re/r - 1 (0 outside (0, re)). */
 static inline double dw_over_r(double r, double re)
 {
     return (r > 0.0 && r < re) ? -re / (r * r * r) : 0.0;
+}
+
+static inline double dot3(const double a[3], const double b[3])
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+typedef struct eff_ctx {
+    const mps_data *m;
+    const mf_particles *p;
+    const mf_pairs *v;
+    const double *xn;  /* r^n */
+    double re, n0;
+    bool linear, project;
+    double *eff;
+} eff_ctx;
+
+/* wall_frame's sums over i's neighbours of the other sort. */
+typedef struct frame_acc {
+    bool mi;
+    double c[3], sw, mean[3];
+} frame_acc;
+
+static inline bool frame_pair(void *acc, const void *ctx, const mf_pair *pr)
+{
+    const eff_ctx *e = ctx;
+    frame_acc *f = acc;
+    const size_t i = pr->i, j = pr->j;
+    if (e->m->is_fluid[j] == f->mi)
+        return true;
+    const double *xi0 = &e->xn[3 * i], *xj0 = &e->xn[3 * j], *xj = &e->p->pos[3 * j];
+    double r0[3] = {xi0[0] - xj0[0], xi0[1] - xj0[1], xi0[2] - xj0[2]};
+    double d0 = sqrt(r0[0] * r0[0] + r0[1] * r0[1] + r0[2] * r0[2]);
+    if (d0 >= e->re)
+        return true;
+    double w = (1.0 - d0 / e->re) * (1.0 - d0 / e->re);
+    f->sw += w;
+    for (int a = 0; a < 3; a++) {
+        f->c[a] += w * r0[a];
+        f->mean[a] += w * (xj[a] - xj0[a]);
+    }
+    return true;
 }
 
 /* Seen from i at r^n, its neighbours of the other sort (fixed ones for a
@@ -67,42 +104,70 @@ static inline double dw_over_r(double r, double re)
  * their centroid to i (smooth weight (1 - r/re)^2, so that it hardly
  * depends on where i sits along the wall lattice), and for a fixed i the
  * mean displacement of its moving neighbours. False if there are none. */
-static bool wall_frame(const mps_data *m, const mf_particles *p, const mf_nlist *nl,
-                       const double *xn, size_t i, double re, double nrm[3], double mean[3])
+static bool wall_frame(const eff_ctx *e, size_t i, double nrm[3], double mean[3])
 {
-    const bool mi = m->is_fluid[i];
-    const double *xi0 = &xn[3 * i];
-    double c[3] = {0, 0, 0}, sw = 0;
-    memset(mean, 0, 3 * sizeof *mean);
-    for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
-        const size_t j = nl->j[k];
-        if (m->is_fluid[j] == mi)
-            continue;
-        const double *xj0 = &xn[3 * j], *xj = &p->pos[3 * j];
-        double r0[3] = {xi0[0] - xj0[0], xi0[1] - xj0[1], xi0[2] - xj0[2]};
-        double d0 = sqrt(r0[0] * r0[0] + r0[1] * r0[1] + r0[2] * r0[2]);
-        if (d0 >= re)
-            continue;
-        double w = (1.0 - d0 / re) * (1.0 - d0 / re);
-        sw += w;
-        for (int a = 0; a < 3; a++) {
-            c[a] += w * r0[a];
-            mean[a] += w * (xj[a] - xj0[a]);
-        }
-    }
-    double len = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-    if (!(len > 0) || !(sw > 0))
+    frame_acc f = {e->m->is_fluid[i], {0, 0, 0}, 0, {0, 0, 0}};
+    mf_pairs_row(e->v, i, NULL, frame_pair, e, &f);
+    memcpy(mean, f.mean, sizeof f.mean);
+    double len = sqrt(f.c[0] * f.c[0] + f.c[1] * f.c[1] + f.c[2] * f.c[2]);
+    if (!(len > 0) || !(f.sw > 0))
         return false;
     for (int a = 0; a < 3; a++) {
-        nrm[a] = c[a] / len;
-        mean[a] /= sw;
+        nrm[a] = f.c[a] / len;
+        mean[a] /= f.sw;
     }
     return true;
 }
 
-static inline double dot3(const double a[3], const double b[3])
+/* effective_density's sum over i's neighbours. */
+typedef struct eff_acc {
+    double sum, nrm[3], mean[3], mean_n;
+    bool mi, wall;
+} eff_acc;
+
+static inline bool eff_pair(void *acc, const void *ctx, const mf_pair *pr)
 {
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    const eff_ctx *e = ctx;
+    eff_acc *s = acc;
+    const size_t i = pr->i, j = pr->j;
+    const double *xi = &e->p->pos[3 * i], *xi0 = &e->xn[3 * i];
+    const bool mi = s->mi, mj = e->m->is_fluid[j];
+    if (!mi && !mj)
+        return true;
+    const double *xj = &e->p->pos[3 * j], *xj0 = &e->xn[3 * j];
+    double r0[3] = {xi0[0] - xj0[0], xi0[1] - xj0[1], xi0[2] - xj0[2]};
+    double d0 = sqrt(dot3(r0, r0));
+    double g = dw_over_r(d0, e->re);
+    /* The relative displacement (a fixed particle's is zero: x = x0). */
+    double rel[3];
+    for (int a = 0; a < 3; a++)
+        rel[a] = (xi[a] - xi0[a]) - (xj[a] - xj0[a]);
+    if (mi && mj && !e->linear) {
+        double r[3] = {xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]};
+        s->sum += mf_weight(sqrt(dot3(r, r)), e->re) - mf_weight(d0, e->re);
+    } else if (mi && mj) {
+        s->sum += g * dot3(r0, rel);
+    } else if (s->wall && mi) {
+        s->sum += g * dot3(r0, s->nrm) * dot3(rel, s->nrm);
+    } else if (s->wall) { /* rel = -(displacement of j) */
+        double deform[3];
+        for (int a = 0; a < 3; a++)
+            deform[a] = rel[a] + s->mean[a];
+        s->sum += g * (dot3(r0, deform) - dot3(r0, s->nrm) * s->mean_n);
+    } else {
+        s->sum += g * dot3(r0, rel);
+    }
+    return true;
+}
+
+static void eff_row(const void *ctx, size_t i)
+{
+    const eff_ctx *e = ctx;
+    eff_acc s = {.sum = e->n0, .mi = e->m->is_fluid[i]};
+    s.wall = e->project && wall_frame(e, i, s.nrm, s.mean);
+    s.mean_n = dot3(s.mean, s.nrm);
+    mf_pairs_row(e->v, i, NULL, eff_pair, e, &s);
+    e->eff[i] = s.sum;
 }
 
 /* n_eff at r* (lists at r*, r^n from the field xn): pairs of moving points
@@ -118,51 +183,14 @@ static inline double dot3(const double a[3], const double b[3])
  * project (rules that move interior points): fixed points sit where the
  * wall lattice is symmetric, and in a corner the one normal is wrong (a
  * resting box with a free surface lost 64% of its points in 2 s with it). */
-static void effective_density(const mps_data *m, const mf_particles *p, const double *xn,
-                              bool linear, bool project, double *eff)
+static int effective_density(const mps_data *m, const mf_sim *sim, const double *xn,
+                             bool linear, bool project, double *eff)
 {
-    const mf_nlist *nl = nd_list(m);
-    const double re = m->k_nd.re, n0 = m->k_nd.n0;
-    const long n = (long)p->n_owned;
-#pragma omp parallel for schedule(static)
-    for (long ii = 0; ii < n; ii++) {
-        const size_t i = (size_t)ii;
-        double sum = n0, nrm[3] = {0, 0, 0}, mean[3] = {0, 0, 0};
-        const double *xi = &p->pos[3 * i], *xi0 = &xn[3 * i];
-        const bool mi = m->is_fluid[i];
-        const bool wall = project && wall_frame(m, p, nl, xn, i, re, nrm, mean);
-        const double mean_n = dot3(mean, nrm);
-        for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
-            const size_t j = nl->j[k];
-            const bool mj = m->is_fluid[j];
-            if (!mi && !mj)
-                continue;
-            const double *xj = &p->pos[3 * j], *xj0 = &xn[3 * j];
-            double r0[3] = {xi0[0] - xj0[0], xi0[1] - xj0[1], xi0[2] - xj0[2]};
-            double d0 = sqrt(dot3(r0, r0));
-            double g = dw_over_r(d0, re);
-            /* The relative displacement (a fixed particle's is zero: x = x0). */
-            double rel[3];
-            for (int a = 0; a < 3; a++)
-                rel[a] = (xi[a] - xi0[a]) - (xj[a] - xj0[a]);
-            if (mi && mj && !linear) {
-                double r[3] = {xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]};
-                sum += mf_weight(sqrt(dot3(r, r)), re) - mf_weight(d0, re);
-            } else if (mi && mj) {
-                sum += g * dot3(r0, rel);
-            } else if (wall && mi) {
-                sum += g * dot3(r0, nrm) * dot3(rel, nrm);
-            } else if (wall) { /* rel = -(displacement of j) */
-                double deform[3];
-                for (int a = 0; a < 3; a++)
-                    deform[a] = rel[a] + mean[a];
-                sum += g * (dot3(r0, deform) - dot3(r0, nrm) * mean_n);
-            } else {
-                sum += g * dot3(r0, rel);
-            }
-        }
-        eff[i] = sum;
-    }
+    mf_pairs v;
+    MF_CALL(mps_pairs(m, sim, m->h_nd, &v));
+    const eff_ctx e = {m, sim->p, &v, xn, m->k_nd.re, m->k_nd.n0, linear, project, eff};
+    mf_pairs_each(&v, NULL, eff_row, &e);
+    return 0;
 }
 
 /* mps_data.before_assembly: offset_i = n*_i - n_eff_i for the unknowns. */
@@ -174,7 +202,7 @@ static int source_offset(mps_data *m, mf_sim *sim, void *ctx)
     const double *xn = mf_particles_fd(p, d->f_pos_n); /* r^n, reordered with the rest */
     /* Only moving interior points slide along the walls in step. */
     const bool project = d->rule != MAFL_RULE_FIXED;
-    effective_density(m, p, xn, d->linear_source, project, d->n_offset);
+    MF_CALL(effective_density(m, sim, xn, d->linear_source, project, d->n_offset));
     for (size_t i = 0; i < p->n_owned; i++)
         d->n_offset[i] = m->in_ppe[i] ? n[i] - d->n_offset[i] : 0.0;
     return 0;

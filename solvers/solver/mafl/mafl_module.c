@@ -54,7 +54,6 @@ static void mafl_destroy_data(mafl_data *d)
     if (d->conv_ops && d->conv.data)
         d->conv_ops->destroy(d->conv.data);
     mf_module_release(&d->conv);
-    mf_grid_free(&d->grid);
     mf_halo_destroy(d->halo);
     free(d->pos_l);
     free(d->pos_new);
@@ -73,7 +72,6 @@ static int create_data(mafl_data *d, mf_sim *sim, const mf_dict *solver_dict)
             d->rule = (mafl_rule)r;
     d->linear_source = strcmp(d->s.density_reference, "divergence") == 0;
     d->incremental = d->linear_source || strcmp(d->s.density_reference, "startOfStep") == 0;
-    mf_grid_init(&d->grid);
     MF_CALL(mps_create_data(&d->s.mps, sim, solver_dict, &d->mps));
     MF_CALL(create_convection(d, sim));
     mf_particles *p = sim->p;

@@ -62,31 +62,43 @@ static int by_key(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* Mark the newer of each pair of fluid points closer than dmin. */
+typedef struct merge_ctx {
+    mafl_data *d;
+    const mf_particles *p;
+    size_t i;
+    double dmin;
+} merge_ctx;
+
+/* i goes if an older fluid point (not itself going) is closer than dmin. */
+static inline bool merge_point(void *acc, const void *ctx, size_t j, const double r[3], double d2)
+{
+    (void)r;
+    const merge_ctx *c = ctx;
+    const mf_particles *p = c->p;
+    if (j == c->i || p->kind[j] != MF_FLUID || c->d->remove[j] || p->id[j] > p->id[c->i])
+        return true;
+    if (d2 < c->dmin * c->dmin) {
+        *(bool *)acc = true;
+        return false;
+    }
+    return true;
+}
+
+/* Mark the newer of each pair of fluid points closer than dmin (in index
+ * order: a point marked earlier no longer removes another). */
 static size_t mark_merges(mafl_data *d, const mf_particles *p, double dmin)
 {
     size_t count = 0;
     for (size_t i = 0; i < p->n_owned; i++) {
         if (p->kind[i] != MF_FLUID)
             continue;
-        const double *xi = &p->pos[3 * i];
-        long cells[27];
-        int nc = mafl_cells_near(&d->grid, xi, cells);
-        for (int c = 0; c < nc && !d->remove[i]; c++)
-            for (size_t m = d->grid.cell_start[cells[c]];
-                 m < d->grid.cell_start[cells[c] + 1] && !d->remove[i]; m++) {
-                size_t j = d->grid.order[m];
-                if (j == i || p->kind[j] != MF_FLUID || d->remove[j] || p->id[j] > p->id[i])
-                    continue;
-                const double *xj = &p->pos[3 * j];
-                double r2 = 0;
-                for (int a = 0; a < 3; a++)
-                    r2 += (xj[a] - xi[a]) * (xj[a] - xi[a]);
-                if (r2 < dmin * dmin) {
-                    d->remove[i] = 1;
-                    count++;
-                }
-            }
+        const merge_ctx c = {d, p, i, dmin};
+        bool close = false;
+        mf_grid_near(d->grid, &p->pos[3 * i], merge_point, &c, &close);
+        if (close) {
+            d->remove[i] = 1;
+            count++;
+        }
     }
     return count;
 }
@@ -111,6 +123,46 @@ static double full_count(int dim, double re, double l0)
     return count;
 }
 
+typedef struct hole_ctx {
+    const mafl_data *d;
+    const mf_particles *p;
+    double dmin, re;
+    bool by_id; /* equal distances: the lowest id is the closest */
+} hole_ctx;
+
+typedef struct hole_acc {
+    double count, best, best_any;
+    size_t closest, nearest;
+    bool occupied; /* a point closer than dmin */
+} hole_acc;
+
+static inline bool hole_point(void *acc, const void *ctx, size_t j, const double r[3], double d2)
+{
+    (void)r;
+    const hole_ctx *c = ctx;
+    hole_acc *a = acc;
+    if (c->d->remove[j])
+        return true;
+    double dist = sqrt(d2);
+    if (dist < c->dmin) {
+        a->occupied = true;
+        return false;
+    }
+    if (dist < c->re)
+        a->count++;
+    if (dist < a->best_any) {
+        a->best_any = dist;
+        a->nearest = j;
+    }
+    if (carries_values(c->p->kind[j]) &&
+        (dist < a->best ||
+         (c->by_id && dist == a->best && c->p->id[j] < c->p->id[a->closest]))) {
+        a->best = dist;
+        a->closest = j;
+    }
+    return true;
+}
+
 /* Is the site x a hole? No point closer than holeDistance, and at least
  * holeDensity of a full lattice's neighbours within re (a count, not the
  * singular weight: one close point must not make an empty site look full).
@@ -119,34 +171,15 @@ static double full_count(int dim, double re, double l0)
 static bool is_hole(const mafl_data *d, const mf_particles *p, const double x[3], double l0,
                     double full, size_t *closest, size_t *nearest)
 {
-    const bool by_id = d->halo != NULL; /* ties broken alike on every rank */
-    const double dmin = d->s.hole_distance * l0, re = d->mps->k_nd.re;
-    double count = 0, best = INFINITY, best_any = INFINITY;
-    long cells[27];
-    int nc = mafl_cells_near(&d->grid, x, cells);
-    for (int c = 0; c < nc; c++)
-        for (size_t m = d->grid.cell_start[cells[c]]; m < d->grid.cell_start[cells[c] + 1]; m++) {
-            size_t j = d->grid.order[m];
-            if (d->remove[j])
-                continue;
-            const double *xj = &p->pos[3 * j];
-            double r = sqrt((xj[0] - x[0]) * (xj[0] - x[0]) + (xj[1] - x[1]) * (xj[1] - x[1]) +
-                            (xj[2] - x[2]) * (xj[2] - x[2]));
-            if (r < dmin)
-                return false;
-            if (r < re)
-                count++;
-            if (r < best_any) {
-                best_any = r;
-                *nearest = j;
-            }
-            if (carries_values(p->kind[j]) &&
-                (r < best || (by_id && r == best && p->id[j] < p->id[*closest]))) {
-                best = r;
-                *closest = j;
-            }
-        }
-    return isfinite(best) && count >= d->s.hole_density * full;
+    /* On several ranks ties are broken alike on every rank (lowest id). */
+    const hole_ctx c = {d, p, d->s.hole_distance * l0, d->mps->k_nd.re, d->halo != NULL};
+    hole_acc a = {0, INFINITY, INFINITY, *closest, *nearest, false};
+    mf_grid_near(d->grid, x, hole_point, &c, &a);
+    *closest = a.closest;
+    *nearest = a.nearest;
+    if (a.occupied)
+        return false;
+    return isfinite(a.best) && a.count >= d->s.hole_density * full;
 }
 
 /* A hole is found the first step its nearest point is more than
@@ -273,7 +306,7 @@ int mafl_update_points(mafl_data *d, mf_sim *sim)
     /* Copies reach a site's neighbours: sites lie within sqrt(3) l0 of a
      * point, their neighbours within the number-density radius. */
     MF_CALL(mafl_copies(d, sim, cell + 2 * l0, false));
-    MF_CALL(mf_grid_build(&d->grid, p, cell));
+    MF_CALL(mf_neighbours_grid(sim->neighbours, p, cell, &d->grid));
     const size_t n_old = p->n_owned;
     memset(d->remove, 0, p->n);
     size_t merged = dmerge > 0 ? mark_merges(d, p, dmerge) : 0;

@@ -45,6 +45,66 @@ static void tangents(int dim, const double nrm[3], double t[2][3])
     t[1][2] = nrm[0] * t[0][1] - nrm[1] * t[0][0];
 }
 
+/* The point queries below run around point i (mf_grid_near on the grid at
+ * r^L) and leave i itself out. */
+typedef struct near_ctx {
+    size_t i;
+    const int32_t *kind0, *flags;
+    double r_norm, r_surf, re;
+    const double *t; /* surface_shift's tangent */
+    double l0;
+} near_ctx;
+
+static inline bool on_surface(const near_ctx *c, size_t j)
+{
+    return c->kind0[j] == MF_FLUID && (c->flags[j] & MPS_FLAG_SURFACE);
+}
+
+typedef struct shift_acc {
+    double centroid[3], mean[3];
+    size_t nall, nsurf;
+} shift_acc;
+
+/* The centroid of the neighbours within r_norm, the mean offset of the
+ * surface neighbours within r_surf. */
+static inline bool shift_point(void *acc, const void *ctx, size_t j, const double r[3],
+                               double d2)
+{
+    const near_ctx *c = ctx;
+    shift_acc *a = acc;
+    if (j == c->i)
+        return true;
+    double dist = sqrt(d2);
+    if (dist < c->r_norm) {
+        for (int q = 0; q < 3; q++)
+            a->centroid[q] += r[q];
+        a->nall++;
+    }
+    if (dist < c->r_surf && on_surface(c, j)) {
+        for (int q = 0; q < 3; q++)
+            a->mean[q] += r[q];
+        a->nsurf++;
+    }
+    return true;
+}
+
+typedef struct side_acc {
+    bool ahead, behind;
+} side_acc;
+
+/* Surface neighbours within r_surf ahead of and behind i along the tangent. */
+static inline bool side_point(void *acc, const void *ctx, size_t j, const double r[3], double d2)
+{
+    const near_ctx *c = ctx;
+    side_acc *a = acc;
+    if (j == c->i || !on_surface(c, j) || d2 >= c->r_surf * c->r_surf)
+        return true;
+    double s = r[0] * c->t[0] + r[1] * c->t[1] + r[2] * c->t[2];
+    a->ahead = a->ahead || s > 0.25 * c->l0;
+    a->behind = a->behind || s < -0.25 * c->l0;
+    return true;
+}
+
 /* A free-surface point follows the flow and is re-spaced along the
  * surface: it moves a share of the way toward the mean of its surface
  * neighbours (within 1.5 l0), projected on the tangent plane. Only a point
@@ -54,74 +114,58 @@ static void surface_shift(const mafl_data *d, const mf_sim *sim, size_t i, const
                           const int32_t *flags, double out[3])
 {
     const double l0 = sim->l0, *xi = &d->pos_l[3 * i];
-    const double r_surf = 1.5 * l0, r_norm = d->s.re_interpolation * l0;
-    double centroid[3] = {0, 0, 0}, mean[3] = {0, 0, 0};
-    size_t nall = 0, nsurf = 0;
-    long cells[27];
-    int nc = mafl_cells_near(&d->grid, xi, cells);
-    for (int c = 0; c < nc; c++)
-        for (size_t k = d->grid.cell_start[cells[c]]; k < d->grid.cell_start[cells[c] + 1]; k++) {
-            size_t j = d->grid.order[k];
-            if (j == i)
-                continue;
-            const double *xj = &d->pos_l[3 * j];
-            double r[3] = {xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]};
-            double dist = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
-            if (dist < r_norm) {
-                for (int a = 0; a < 3; a++)
-                    centroid[a] += r[a];
-                nall++;
-            }
-            if (dist < r_surf && kind0[j] == MF_FLUID && (flags[j] & MPS_FLAG_SURFACE)) {
-                for (int a = 0; a < 3; a++)
-                    mean[a] += r[a];
-                nsurf++;
-            }
-        }
+    near_ctx c = {i, kind0, flags, d->s.re_interpolation * l0, 1.5 * l0, 0, NULL, l0};
+    shift_acc a = {{0, 0, 0}, {0, 0, 0}, 0, 0};
+    mf_grid_near(d->grid, xi, shift_point, &c, &a);
     memset(out, 0, 3 * sizeof *out);
-    if (nall == 0 || nsurf < 2)
+    if (a.nall == 0 || a.nsurf < 2)
         return;
     /* Outward normal: away from the neighbours' centroid. */
     double nrm[3], len = 0;
-    for (int a = 0; a < 3; a++) {
-        nrm[a] = -centroid[a] / (double)nall;
-        len += nrm[a] * nrm[a];
+    for (int q = 0; q < 3; q++) {
+        nrm[q] = -a.centroid[q] / (double)a.nall;
+        len += nrm[q] * nrm[q];
     }
     len = sqrt(len);
     if (len < 1e-3 * l0)
         return;
-    for (int a = 0; a < 3; a++)
-        nrm[a] /= len;
+    for (int q = 0; q < 3; q++)
+        nrm[q] /= len;
     double t[2][3];
     tangents(sim->dim, nrm, t);
     /* Surrounded along each tangent? */
     for (int tk = 0; tk < sim->dim - 1; tk++) {
-        bool ahead = false, behind = false;
-        for (int c = 0; c < nc; c++)
-            for (size_t k = d->grid.cell_start[cells[c]]; k < d->grid.cell_start[cells[c] + 1];
-                 k++) {
-                size_t j = d->grid.order[k];
-                if (j == i || kind0[j] != MF_FLUID || !(flags[j] & MPS_FLAG_SURFACE))
-                    continue;
-                const double *xj = &d->pos_l[3 * j];
-                double r[3] = {xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]};
-                if (r[0] * r[0] + r[1] * r[1] + r[2] * r[2] >= r_surf * r_surf)
-                    continue;
-                double s = r[0] * t[tk][0] + r[1] * t[tk][1] + r[2] * t[tk][2];
-                ahead = ahead || s > 0.25 * l0;
-                behind = behind || s < -0.25 * l0;
-            }
-        if (!ahead || !behind)
+        side_acc s = {false, false};
+        c.t = t[tk];
+        mf_grid_near(d->grid, xi, side_point, &c, &s);
+        if (!s.ahead || !s.behind)
             return;
     }
-    for (int a = 0; a < 3; a++)
-        mean[a] /= (double)nsurf;
+    double mean[3];
+    for (int q = 0; q < 3; q++)
+        mean[q] = a.mean[q] / (double)a.nsurf;
     double normal_part = mean[0] * nrm[0] + mean[1] * nrm[1] + mean[2] * nrm[2];
-    for (int a = 0; a < 3; a++)
-        out[a] = d->s.surface_shift * (mean[a] - normal_part * nrm[a]);
+    for (int q = 0; q < 3; q++)
+        out[q] = d->s.surface_shift * (mean[q] - normal_part * nrm[q]);
     if (sim->dim == 2)
         out[2] = 0;
     clamp_shift(out, MAX_SHIFT * l0);
+}
+
+/* The eq. 5 sum of the particle distribution: sum_j w_ij r_ij/|r_ij|^2. */
+static inline bool relax_point(void *acc, const void *ctx, size_t j, const double r[3],
+                               double d2)
+{
+    const near_ctx *c = ctx;
+    double *sum = acc;
+    if (j == c->i)
+        return true;
+    double w = mf_weight(sqrt(d2), c->re);
+    if (w <= 0)
+        return true;
+    for (int q = 0; q < 3; q++)
+        sum[q] += w * r[q] / d2;
+    return true;
 }
 
 /* Rule relax: toward an even distribution, against the imbalance of the
@@ -130,30 +174,38 @@ static void surface_shift(const mafl_data *d, const mf_sim *sim, size_t i, const
 static void relax_shift(const mafl_data *d, const mf_sim *sim, size_t i, double out[3])
 {
     const mf_kernel *k = &d->mps->k_grad;
-    const double *xi = &d->pos_l[3 * i];
+    const near_ctx c = {.i = i, .re = k->re};
     double sum[3] = {0, 0, 0};
-    long cells[27];
-    int nc = mafl_cells_near(&d->grid, xi, cells);
-    for (int c = 0; c < nc; c++)
-        for (size_t m = d->grid.cell_start[cells[c]]; m < d->grid.cell_start[cells[c] + 1]; m++) {
-            size_t j = d->grid.order[m];
-            if (j == i)
-                continue;
-            const double *xj = &d->pos_l[3 * j];
-            double r[3] = {xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]};
-            double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-            double w = mf_weight(sqrt(r2), k->re);
-            if (w <= 0)
-                continue;
-            for (int a = 0; a < 3; a++)
-                sum[a] += w * r[a] / r2;
-        }
+    mf_grid_near(d->grid, &d->pos_l[3 * i], relax_point, &c, sum);
     const double scale = -d->s.shift * k->dim * sim->l0 * sim->l0 / k->n0;
-    for (int a = 0; a < 3; a++)
-        out[a] = scale * sum[a];
+    for (int q = 0; q < 3; q++)
+        out[q] = scale * sum[q];
     if (sim->dim == 2)
         out[2] = 0;
     clamp_shift(out, MAX_SHIFT * sim->l0);
+}
+
+typedef struct sided_acc {
+    double sum[3];
+    size_t count;
+    bool emitter; /* an inlet or outlet point among the neighbours */
+} sided_acc;
+
+static inline bool sided_point(void *acc, const void *ctx, size_t j, const double r[3],
+                               double d2)
+{
+    const near_ctx *c = ctx;
+    sided_acc *a = acc;
+    if (j == c->i || d2 >= c->re * c->re)
+        return true;
+    if (c->kind0[j] == MF_INLET || c->kind0[j] == MF_OUTLET) {
+        a->emitter = true;
+        return false;
+    }
+    for (int q = 0; q < 3; q++)
+        a->sum[q] += r[q];
+    a->count++;
+    return true;
 }
 
 /* The MPS flag (n* < beta n0, eq. 18) also marks interior points that only
@@ -167,30 +219,16 @@ static void relax_shift(const mafl_data *d, const mf_sim *sim, size_t i, double 
  * packed the points after it to about 0.75 l0). */
 static bool one_sided(const mafl_data *d, const mf_sim *sim, const int32_t *kind0, size_t i)
 {
-    const double *xi = &d->pos_l[3 * i], re = d->s.re_interpolation * sim->l0;
-    double sum[3] = {0, 0, 0};
-    size_t count = 0;
-    long cells[27];
-    int nc = mafl_cells_near(&d->grid, xi, cells);
-    for (int c = 0; c < nc; c++)
-        for (size_t m = d->grid.cell_start[cells[c]]; m < d->grid.cell_start[cells[c] + 1]; m++) {
-            size_t j = d->grid.order[m];
-            const double *xj = &d->pos_l[3 * j];
-            double r[3] = {xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]};
-            double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-            if (j == i || r2 >= re * re)
-                continue;
-            if (kind0[j] == MF_INLET || kind0[j] == MF_OUTLET)
-                return false;
-            for (int a = 0; a < 3; a++)
-                sum[a] += r[a];
-            count++;
-        }
-    if (count == 0)
+    const near_ctx c = {.i = i, .kind0 = kind0, .re = d->s.re_interpolation * sim->l0};
+    sided_acc a = {{0, 0, 0}, 0, false};
+    mf_grid_near(d->grid, &d->pos_l[3 * i], sided_point, &c, &a);
+    if (a.emitter)
+        return false;
+    if (a.count == 0)
         return true;
     double off2 = 0;
-    for (int a = 0; a < 3; a++)
-        off2 += (sum[a] / count) * (sum[a] / count);
+    for (int q = 0; q < 3; q++)
+        off2 += (a.sum[q] / a.count) * (a.sum[q] / a.count);
     return off2 > 0.04 * sim->l0 * sim->l0;
 }
 

@@ -7,32 +7,6 @@
 #include "mf_halo.h"
 #include "mf_run.h"
 
-int mafl_cells_near(const mf_grid *g, const double x[3], long cells[27])
-{
-    if (g->ncells == 0)
-        return 0;
-    const double w = g->cell_size * (1.0 + MF_GRID_CELL_SLACK);
-    long lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
-    for (int a = 0; a < g->dim; a++) {
-        double u = floor((x[a] - g->origin[a]) / w);
-        if (!(u + 1 >= 0) || !(u - 1 < (double)g->nbox[a]))
-            return 0; /* more than a cell outside the box, or NaN */
-        long c = (long)u;
-        lo[a] = c - 1 < 0 ? 0 : c - 1;
-        hi[a] = c + 1 >= (long)g->nbox[a] ? (long)g->nbox[a] - 1 : c + 1;
-    }
-    int count = 0;
-    for (long iz = lo[2]; iz <= hi[2]; iz++)
-        for (long iy = lo[1]; iy <= hi[1]; iy++)
-            for (long ix = lo[0]; ix <= hi[0]; ix++) {
-                long c = mf_grid_find_cell(g, mf_grid_key((uint64_t)ix, (uint64_t)iy,
-                                                          (uint64_t)iz));
-                if (c >= 0)
-                    cells[count++] = c;
-            }
-    return count;
-}
-
 /* Keep r^n, u^n and the kinds in fields (the MPS step may reorder the
  * particles); inlet and outlet points join the Lagrangian motion as fluid,
  * so that the fluid beside them is neither stretched nor squeezed. */
@@ -157,7 +131,7 @@ int mafl_step(mafl_data *d, mf_sim *sim, double dt)
     if (d->halo)
         MF_CALL(mafl_copies(d, sim, fmax(cell * sim->l0, eulerian_reach(d, sim)), true));
     memcpy(d->pos_l, p->pos, 3 * p->n * sizeof *d->pos_l);
-    MF_CALL(mf_grid_build(&d->grid, p, cell * sim->l0));
+    MF_CALL(mf_neighbours_grid(sim->neighbours, p, cell * sim->l0, &d->grid));
     MF_CALL(mafl_reconfigure(d, sim, dt));
     double t2 = mf_wall_seconds();
     d->t_reconfigure += t2 - t1;

@@ -22,6 +22,7 @@
 #include "mf_kernel.h"
 #include "mf_modules.h"
 #include "mf_neighbours.h"
+#include "mf_pairs.h"
 
 typedef struct mps_settings {
     double re_number_density; /* radii in units of l0 */
@@ -43,32 +44,16 @@ typedef struct mps_settings {
     double periodic_origin;   /* x of the periodic box's lower face, m */
 } mps_settings;
 
-/* Pair averages (eq. 27 with unlike neighbours; the variable-density PPE).
- * Density: 1/rho_ij = 1/rho_bar_ij with rho_bar the arithmetic mean
- * (rho_i + rho_j)/2 (the default: the series coefficient of a flux across
- * an interface, as a finite-volume face would take it) or the harmonic
- * mean 2 rho_i rho_j/(rho_i + rho_j), i.e. 1/rho_ij = (1/rho_i + 1/rho_j)/2.
- * Viscosity: mu_ij harmonic (default) or arithmetic mean of mu = rho nu. */
-typedef enum { MPS_AVERAGE_ARITHMETIC = 0, MPS_AVERAGE_HARMONIC = 1 } mps_average;
-
-static inline double mps_inv_rho_pair(double rho_i, double rho_j, int average)
-{
-    return average == MPS_AVERAGE_HARMONIC ? 0.5 * (1.0 / rho_i + 1.0 / rho_j)
-                                           : 2.0 / (rho_i + rho_j);
-}
-
-static inline double mps_mu_pair(double mu_i, double mu_j, int average)
-{
-    if (average == MPS_AVERAGE_ARITHMETIC)
-        return 0.5 * (mu_i + mu_j);
-    return mu_i + mu_j > 0.0 ? 2.0 * mu_i * mu_j / (mu_i + mu_j) : 0.0;
-}
+/* Pair averages: mf_inv_rho_pair, mf_mu_pair (mf_kernel.h); mps_data's
+ * rho_average and mu_average are mf_average values. */
 
 typedef struct mps_data {
     mps_settings s;
     mf_kernel k_nd, k_grad, k_lap; /* one kernel per operator radius */
-    mf_grid grid;
-    mf_nlist nl_max, nl_nd, nl_grad, nl_lap; /* at the largest radius, and filtered */
+    /* Neighbour requests (sim->neighbours), all in the order of cells of the
+     * largest radius: that radius, each operator's, and the collision's. */
+    mf_neighbours *nb;
+    int h_max, h_nd, h_grad, h_lap, h_coll;
     /* Field indices in the particle storage. */
     int f_pressure, f_number_density, f_flags;
     /* Pressure module. */
@@ -80,6 +65,7 @@ typedef struct mps_data {
     double *grad;      /* 3n: pressure gradient */
     uint8_t *is_fluid, *in_ppe, *dirichlet, *not_dummy;
     long *row;         /* particle -> PPE row, -1 if not in the system */
+    long *row_global;  /* on several ranks: particle -> global PPE row (copies: their owners') */
     double *rhs, *x;
     mf_csr A;
     size_t cap_rows, cap_nnz;
@@ -96,7 +82,7 @@ typedef struct mps_data {
      * per particle (walls included) and follow the current particle order. */
     const double *rho;         /* density; NULL: sim->fluid[0].rho */
     const double *mu;          /* dynamic viscosity of fluids; NULL: sim->fluid[0].nu */
-    int rho_average, mu_average; /* mps_average of each pair */
+    int rho_average, mu_average; /* mf_average of each pair */
     /* PPE: the pressure of particles that are not unknowns but take part
      * (non-dummy neighbours: free surface, or held by another solve); NULL: 0. */
     const double *p_dirichlet;
@@ -185,9 +171,12 @@ void mps_destroy_data(mps_data *d);
 int mps_reserve(mps_data *d, size_t n);
 
 /* mps_step.c: phases of one step (Algorithm 1). */
-/* Grid and lists at the current positions; with reorder, particles are
- * first sorted along cells every reorder_interval steps. */
+/* An order point of the neighbour service at the current positions, and the
+ * lists there; with reorder, particles are first sorted along cells every
+ * reorder_interval steps. */
 int mps_build_neighbours(mps_data *d, mf_sim *sim, bool reorder);
+/* The pairs of one of mps_data's requests at the current positions. */
+int mps_pairs(const mps_data *d, const mf_sim *sim, int handle, mf_pairs *out);
 void mps_set_masks(mps_data *d, const mf_particles *p);          /* is_fluid, not_dummy */
 int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt);     /* eqs. 9-10 (27) */
 /* eq. 18: number density at r*, free surface, PPE unknowns (in_ppe). */
@@ -201,17 +190,14 @@ int mps_lagrangian_step(mps_data *d, mf_sim *sim, double dt);
 int mps_assemble_ppe(mps_data *d, const mf_sim *sim, double dt);
 int mps_solve_ppe(mps_data *d, mf_sim *sim);
 
-/* mps_pairs.c: the operators with a per-pair coefficient (multi-fluid). */
-/* eq. 27's viscous term: acc_i += 2d/(lambda n0) (1/rho_i) sum_j mu_ij (u_j - u_i) w_ij
- * for fluid i (walls and dummies: u = 0, mu_ij = mu_i). */
-void mps_viscous_pairs(const mps_data *d, const mf_particles *p, const mf_nlist *nl,
-                       double *acc);
+/* mps_pairs.c: the correction with a per-pair coefficient (multi-fluid). */
 /* eq. 15 with 1/rho_ij: grad_i = d/n0 sum_j (1/rho_ij) (p_j - p^_i) r_ij/|r_ij|^2 w_ij
  * (the pressure acceleration, already divided by the density), p^_i = p_i or
  * the neighbourhood minimum (gradientPmin), into d->grad for the fluid
- * particles with imask set (NULL: all fluid); p of non-dummy neighbours. */
-void mps_gradient_pairs(mps_data *d, const mf_particles *p, const double *pressure,
-                        const uint8_t *imask);
+ * particles with imask set (NULL: all fluid; imask holds fluid particles
+ * only); p of non-dummy neighbours. */
+int mps_gradient_pairs(mps_data *d, const mf_sim *sim, const double *pressure,
+                       const uint8_t *imask);
 /* eqs. 16-17 for those particles: u' = -dt grad, u += u', r += dt u'.
  * Returns max |u'|. */
 double mps_apply_correction(mps_data *d, mf_particles *p, double dt, const uint8_t *imask);
@@ -250,12 +236,15 @@ void mps_halo_end(mps_data *d, mf_sim *sim);    /* drop them, wrap */
 int mps_halo_sync(const mps_data *d, const mf_sim *sim, void *values, size_t size);
 /* Positions and velocities of the copies from their owners'. */
 int mps_halo_sync_motion(const mps_data *d, const mf_sim *sim);
-/* Global row numbers: row[i] of the owned particles holds a local row (or
- * -1) of the nrows this rank has; on return it holds the global row (the
- * ranks' rows follow each other in rank order), the copies hold their
- * owners', and *offset, *nglobal say where this rank's rows start and how
- * many there are in all. */
-int mps_global_rows(const mps_data *d, const mf_sim *sim, long *row, size_t nrows, int64_t *offset,
-                    int64_t *nglobal);
+/* Rows over the ranks: row[i] of the owned particles holds a local row (or
+ * -1) of the nrows this rank has. *offset, *nglobal: where this rank's rows
+ * start (the ranks' rows follow each other in rank order) and how many
+ * there are in all. On one rank an image's row[j] becomes its owner's and
+ * *global_col is NULL (column = offset + row). On several, global[] (n
+ * entries) holds every particle's global row, the copies their owners',
+ * row[j] of a copy says only whether it has one (0 or -1), and *global_col
+ * is global (mf_rows.global_col). */
+int mps_global_rows(const mps_data *d, const mf_sim *sim, long *row, size_t nrows,
+                    long *global, int64_t *offset, int64_t *nglobal, const long **global_col);
 
 #endif

@@ -215,17 +215,23 @@ int mps_halo_sync_motion(const mps_data *d, const mf_sim *sim)
     return 0;
 }
 
-int mps_global_rows(const mps_data *d, const mf_sim *sim, long *row, size_t nrows, int64_t *offset,
-                    int64_t *nglobal)
+int mps_global_rows(const mps_data *d, const mf_sim *sim, long *row, size_t nrows,
+                    long *global, int64_t *offset, int64_t *nglobal, const long **global_col)
 {
     const mf_particles *p = sim->p;
     *offset = mf_parallel_exscan(sim->par, (int64_t)nrows);
     *nglobal = (int64_t)nrows;
     mf_parallel_sum_i64(sim->par, nglobal, 1);
-    if (*offset)
-        for (size_t i = 0; i < p->n_owned; i++)
-            if (row[i] >= 0)
-                row[i] += (long)*offset;
-    MF_CALL(mps_halo_sync(d, sim, row, sizeof *row));
+    *global_col = NULL;
+    if (!sim->par) { /* one rank: an image is its owner's local row */
+        MF_CALL(mps_halo_sync(d, sim, row, sizeof *row));
+        return 0;
+    }
+    for (size_t i = 0; i < p->n_owned; i++)
+        global[i] = row[i] >= 0 ? (long)*offset + row[i] : -1;
+    MF_CALL(mps_halo_sync(d, sim, global, sizeof *global));
+    for (size_t j = p->n_owned; j < p->n; j++) /* a copy: has a column or not */
+        row[j] = global[j] >= 0 ? 0 : -1;
+    *global_col = global;
     return 0;
 }

@@ -19,6 +19,27 @@ static int create_pressure(mps_data *d, mf_sim *sim, const mf_dict *solver_dict)
     return 0;
 }
 
+/* Every radius in the order of the largest one's cells (the order every
+ * sum has had since the first MPS step of this code). */
+static int request_neighbours(mps_data *d, mf_sim *sim)
+{
+    d->nb = sim->neighbours;
+    if (!d->nb)
+        return MF_ERROR(MF_ERR_INPUT, "solver MPS: the run has no neighbour service");
+    double rmax = d->k_nd.re;
+    if (d->k_grad.re > rmax) rmax = d->k_grad.re;
+    if (d->k_lap.re > rmax) rmax = d->k_lap.re;
+    MF_CALL(mf_neighbours_request(d->nb, rmax, rmax, &d->h_max));
+    MF_CALL(mf_neighbours_request(d->nb, d->k_nd.re, rmax, &d->h_nd));
+    MF_CALL(mf_neighbours_request(d->nb, d->k_grad.re, rmax, &d->h_grad));
+    MF_CALL(mf_neighbours_request(d->nb, d->k_lap.re, rmax, &d->h_lap));
+    const double dc = d->s.collision_distance * sim->l0;
+    d->h_coll = -1;
+    if (d->s.collision)
+        MF_CALL(mf_neighbours_request(d->nb, dc < rmax ? dc : rmax, rmax, &d->h_coll));
+    return 0;
+}
+
 int mps_reserve(mps_data *d, size_t n)
 {
     if (n <= d->cap)
@@ -31,8 +52,9 @@ int mps_reserve(mps_data *d, size_t n)
     d->dirichlet = realloc(d->dirichlet, cap);
     d->not_dummy = realloc(d->not_dummy, cap);
     d->row = realloc(d->row, cap * sizeof *d->row);
+    d->row_global = realloc(d->row_global, cap * sizeof *d->row_global);
     if (!d->acc || !d->grad || !d->is_fluid || !d->in_ppe || !d->dirichlet || !d->not_dummy ||
-        !d->row)
+        !d->row || !d->row_global)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu particles", n);
     d->cap = cap;
     return 0;
@@ -48,14 +70,10 @@ int mps_create_data(const mps_settings *s, mf_sim *sim, const mf_dict *solver_di
         return MF_ERROR(MF_ERR_MEMORY, "out of memory");
     *out = d;
     d->s = *s;
-    mf_grid_init(&d->grid);
-    mf_nlist_init(&d->nl_max);
-    mf_nlist_init(&d->nl_nd);
-    mf_nlist_init(&d->nl_grad);
-    mf_nlist_init(&d->nl_lap);
     MF_CALL(mf_kernel_init(&d->k_nd, sim->dim, sim->l0, s->re_number_density * sim->l0));
     MF_CALL(mf_kernel_init(&d->k_grad, sim->dim, sim->l0, s->re_gradient * sim->l0));
     MF_CALL(mf_kernel_init(&d->k_lap, sim->dim, sim->l0, s->re_laplacian * sim->l0));
+    MF_CALL(request_neighbours(d, sim));
     sim->n0 = d->k_nd.n0; /* the NumberDensity field's reference, for the run's watch */
     d->rho_default = sim->fluid[0].rho;
     MF_CALL(mf_particles_request_field(sim->p, "Pressure", 1, MF_FIELD_DOUBLE, true,
@@ -87,11 +105,6 @@ void mps_destroy_data(mps_data *d)
     mf_module_release(&d->pressure);
     mps_viscosity_destroy(d->visc);
     mps_halo_destroy(d->halo);
-    mf_grid_free(&d->grid);
-    mf_nlist_free(&d->nl_max);
-    mf_nlist_free(&d->nl_nd);
-    mf_nlist_free(&d->nl_grad);
-    mf_nlist_free(&d->nl_lap);
     free(d->acc);
     free(d->grad);
     free(d->is_fluid);
@@ -99,6 +112,7 @@ void mps_destroy_data(mps_data *d)
     free(d->dirichlet);
     free(d->not_dummy);
     free(d->row);
+    free(d->row_global);
     free(d->rhs);
     free(d->x);
     free(d->A.rowptr);
@@ -190,6 +204,13 @@ static void mps_report(void *data, const mf_sim *sim, mf_log *log)
                   "average\n",
                   rows,
                   (double)sim->pressure_iterations / (d->solves > 0 ? (double)d->solves : 1.0));
+    mf_neighbours_stats nb;
+    mf_neighbours_get_stats(d->nb, &nb);
+    mf_log_printf(log, MF_LOG_QUIET,
+                  "MPS neighbours: %ld list builds and %ld re-sorts in %ld steps, %.1f list "
+                  "entries a particle, %.1f MB\n",
+                  nb.builds, nb.sorts, d->attempts, nb.entries,
+                  mf_neighbours_memory(d->nb) / 1048576.0);
     mps_viscosity_report(d->visc, sim, log);
 }
 

@@ -27,26 +27,51 @@
 #include "mf_run.h"
 #include "mps.h"
 
+/* Grow *ptr to count elements, keeping the old block when that fails. */
+static int grow(void **ptr, size_t count, size_t elem)
+{
+    void *grown = realloc(*ptr, count * elem);
+    if (!grown)
+        return MF_ERR_MEMORY;
+    *ptr = grown;
+    return 0;
+}
+
+/* Room for rows unknowns and nnz entries; 1/16 headroom (the counts drift
+ * little from step to step, and the matrix is the largest array of a run). */
 static int reserve_system(mps_data *d, size_t rows, size_t nnz)
 {
     if (rows + 1 > d->cap_rows) {
-        size_t cap = rows + rows / 4 + 64;
-        d->A.rowptr = realloc(d->A.rowptr, (cap + 1) * sizeof *d->A.rowptr);
-        d->rhs = realloc(d->rhs, cap * sizeof *d->rhs);
-        d->x = realloc(d->x, cap * sizeof *d->x);
-        if (!d->A.rowptr || !d->rhs || !d->x)
+        size_t cap = rows + rows / 16 + 64;
+        if (grow((void **)&d->A.rowptr, cap + 1, sizeof *d->A.rowptr) ||
+            grow((void **)&d->rhs, cap, sizeof *d->rhs) || grow((void **)&d->x, cap, sizeof *d->x))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu pressure unknowns", rows);
         d->cap_rows = cap;
     }
     if (nnz > d->cap_nnz) {
-        size_t cap = nnz + nnz / 4 + 64;
-        d->A.col = realloc(d->A.col, cap * sizeof *d->A.col);
-        d->A.val = realloc(d->A.val, cap * sizeof *d->A.val);
-        if (!d->A.col || !d->A.val)
+        size_t cap = nnz + nnz / 16 + 64;
+        if (grow((void **)&d->A.col, cap, sizeof *d->A.col) ||
+            grow((void **)&d->A.val, cap, sizeof *d->A.val))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu matrix entries", nnz);
         d->cap_nnz = cap;
     }
     return 0;
+}
+
+/* Is j a copy of another rank's unknown that its owner's search reached? */
+typedef struct reach_ctx {
+    const uint8_t *in_ppe, *flag;
+    size_t n_owned;
+} reach_ctx;
+
+static inline bool reached_copy(void *acc, const void *ctx, const mf_pair *pr)
+{
+    const reach_ctx *c = ctx;
+    if (pr->j >= c->n_owned && c->in_ppe[pr->j] && c->flag[pr->j]) {
+        *(bool *)acc = true;
+        return false;
+    }
+    return true;
 }
 
 /* Rows reachable from a row that touches a Dirichlet particle are fine;
@@ -54,7 +79,7 @@ static int reserve_system(mps_data *d, size_t rows, size_t nnz)
  * several ranks in rounds: each rank searches its rows, the copies learn
  * whether their owners were reached, and a row next to a reached copy
  * starts the next round, until no rank reaches a new row. */
-static int regularise_closed_groups(mps_data *d, const mf_sim *sim, const mf_nlist *nl,
+static int regularise_closed_groups(mps_data *d, const mf_sim *sim, const mf_pairs *nl,
                                     const uint8_t *touches_dirichlet, size_t *nfixed)
 {
     const mf_particles *p = sim->p;
@@ -101,20 +126,19 @@ static int regularise_closed_groups(mps_data *d, const mf_sim *sim, const mf_nli
                 break;
         }
         for (size_t i = 0; i < p->n_owned; i++)
-            flag[i] = d->row[i] >= 0 && seen[d->row[i] - offset];
+            flag[i] = d->row[i] >= 0 && seen[d->row[i]];
         MF_CALL_GOTO(rc, mps_halo_sync(d, sim, flag, 1), done);
         double reached = 0;
         for (size_t i = 0; i < p->n_owned; i++) {
-            if (d->row[i] < 0 || seen[d->row[i] - offset])
+            if (d->row[i] < 0 || seen[d->row[i]])
                 continue;
-            for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
-                size_t j = nl->j[k];
-                if (j >= p->n_owned && d->in_ppe[j] && flag[j]) {
-                    seen[d->row[i] - offset] = 1;
-                    queue[tail++] = (size_t)(d->row[i] - offset);
-                    reached++;
-                    break;
-                }
+            const reach_ctx rc_ctx = {d->in_ppe, flag, p->n_owned};
+            bool hit = false;
+            mf_pairs_row_r2(nl, i, NULL, reached_copy, &rc_ctx, &hit);
+            if (hit) {
+                seen[d->row[i]] = 1;
+                queue[tail++] = (size_t)d->row[i];
+                reached++;
             }
         }
         mf_parallel_sum(sim->par, &reached, 1);
@@ -136,29 +160,122 @@ done:
     return rc;
 }
 
+/* One PPE row (the header's A_ii, A_ij, rhs_i) from the pair engine's
+ * assemble sink: the coefficient kernel is c w_ij (1/rho_ij), a Dirichlet
+ * neighbour's known pressure goes to the right-hand side. */
+typedef struct ppe_ctx {
+    mps_data *d;
+    const mf_sim *sim;
+    mf_pairs v;
+    mf_rows rows;
+    double c, dt, rho, n0, re;
+    const double *rho_p, *pd, *n, *pressure;
+    int avg;
+    uint8_t *touches;
+} ppe_ctx;
+
+typedef struct ppe_acc {
+    double known;   /* sum of c w_ij p_j / rho_ij over the Dirichlet neighbours */
+    bool touches;   /* a Dirichlet neighbour with w > 0 */
+} ppe_acc;
+
+static inline double ppe_coef(const void *ctx, const mf_pair *pr)
+{
+    const ppe_ctx *c = ctx;
+    double cw = c->c * mf_weight(pr->len, c->re);
+    if (c->rho_p)
+        cw *= mf_inv_rho_pair(c->rho_p[pr->i], c->rho_p[pr->j], c->avg);
+    return cw;
+}
+
+static inline void ppe_known(void *acc, const void *ctx, const mf_pair *pr, double a)
+{
+    const ppe_ctx *c = ctx;
+    ppe_acc *k = acc;
+    if (mf_weight(pr->len, c->re) > 0) {
+        k->touches = true;
+        if (c->pd)
+            k->known += a * c->pd[pr->j];
+    }
+}
+
+/* false: a fluid particle with no non-dummy neighbour (reported by the caller). */
+static bool ppe_row(const void *ctx, size_t i, size_t r)
+{
+    const ppe_ctx *c = ctx;
+    mps_data *d = c->d;
+    ppe_acc acc = {0.0, false};
+    const size_t diag = c->rows.rowptr[r];
+    const double sum = mf_pairs_row_assemble(&c->v, i, d->not_dummy, NULL, ppe_coef, ppe_known,
+                                             c, &acc, &c->rows, r);
+    if (!(sum > 0) && d->is_fluid[i])
+        return false;
+    const double dt2 = c->dt * c->dt;
+    /* n* - n0, or against a per-particle reference (mps_data.n_offset) */
+    const double dn = d->n_offset ? c->n[i] - c->n0 - d->n_offset[i] : c->n[i] - c->n0;
+    double *val = d->A.val;
+    if (c->rho_p) {
+        val[diag] = sum + d->s.compressibility / dt2;
+        d->rhs[r] = d->s.relaxation / dt2 * dn / c->n0;
+    } else {
+        val[diag] = sum + d->s.compressibility * c->rho / dt2;
+        d->rhs[r] = d->s.relaxation * c->rho / dt2 * dn / c->n0;
+    }
+    if (c->pd)
+        d->rhs[r] += acc.known;
+    c->touches[r] = acc.touches;
+    if (!(sum > 0) && d->s.compressibility <= 0) {
+        /* A wall particle with only dummies within re: no equation
+         * couples it, so it takes p = 0 (a zero row is singular). */
+        val[diag] = c->c;
+        d->rhs[r] = 0;
+        c->touches[r] = 1;
+    }
+    if (d->s.compressibility > 0)
+        c->touches[r] = 1;
+    d->x[r] = c->pressure[i]; /* warm start from the last step */
+    return true;
+}
+
+static size_t ppe_count(const void *ctx, size_t i)
+{
+    const ppe_ctx *c = ctx;
+    return mf_pairs_row_count(&c->v, i, c->d->not_dummy, NULL, c, c->rows.col_of);
+}
+
+/* Between the count and the fill: room for the entries. */
+static int ppe_sized(void *ctx, size_t nnz)
+{
+    ppe_ctx *c = ctx;
+    MF_CALL(reserve_system(c->d, c->d->A.nrows, nnz));
+    c->rows.col = c->d->A.col;
+    c->rows.val = c->d->A.val;
+    c->rows.rowptr = c->d->A.rowptr;
+    return 0;
+}
+
 int mps_assemble_ppe(mps_data *d, const mf_sim *sim, double dt)
 {
     double t0 = mf_wall_seconds();
     const mf_particles *p = sim->p;
-    const mf_nlist *nl = d->k_lap.re >= d->nl_max.radius ? &d->nl_max : &d->nl_lap;
-    const double *n = mf_particles_fd(p, d->f_number_density);
     /* Which copies are unknowns: their owners decided (a composing solver
      * may have changed the owned ones since the surface phase). */
     MF_CALL(mps_halo_sync(d, sim, d->in_ppe, 1));
-    size_t nrows = 0, nnz = 0;
-    for (size_t i = 0; i < p->n_owned; i++) {
+    size_t nrows = 0;
+    for (size_t i = 0; i < p->n_owned; i++)
         d->row[i] = d->in_ppe[i] ? (long)nrows++ : -1;
-        if (d->in_ppe[i]) {
-            nnz++;
-            for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++)
-                nnz += d->in_ppe[nl->j[k]];
-        }
-    }
-    /* Global rows: a copy is its owner's unknown (an image, or a particle of
-     * another rank). */
+    /* Rows over the ranks: a copy is its owner's unknown (an image, or a
+     * particle of another rank). */
     int64_t offset = 0, nglobal = 0;
-    MF_CALL(mps_global_rows(d, sim, d->row, nrows, &offset, &nglobal));
-    MF_CALL(reserve_system(d, nrows, nnz));
+    const long *global_col = NULL;
+    MF_CALL(mps_global_rows(d, sim, d->row, nrows, d->row_global, &offset, &nglobal,
+                            &global_col));
+    if (nglobal > MF_CSR_MAX_GLOBAL)
+        return MF_ERROR(MF_ERR_INPUT,
+                        "%lld pressure unknowns: the matrix's columns are 32-bit (hypre's "
+                        "HYPRE_BigInt), at most %d in all",
+                        (long long)nglobal, MF_CSR_MAX_GLOBAL);
+    MF_CALL(reserve_system(d, nrows, 0));
     uint8_t *touches = calloc(nrows ? nrows : 1, 1);
     if (!touches)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory");
@@ -166,88 +283,51 @@ int mps_assemble_ppe(mps_data *d, const mf_sim *sim, double dt)
     A->nrows = nrows;
     A->row_offset = offset;
     A->nglobal = nglobal;
-    const double c = 2.0 * d->k_lap.dim / (d->k_lap.lambda * d->k_lap.n0);
-    const double rho = sim->fluid[0].rho, n0 = d->k_nd.n0, re = nl->radius;
-    const double *rho_p = d->rho, *pd = d->p_dirichlet;
-    const int avg = d->rho_average;
-    const double *pressure = mf_particles_fd(p, d->f_pressure);
-    size_t pos = 0;
-    int wall_rc = 0;
-    for (size_t i = 0; i < p->n_owned; i++) {
-        if (!d->in_ppe[i])
-            continue;
-        size_t r = (size_t)(d->row[i] - offset);
-        A->rowptr[r] = pos;
-        size_t diag = pos++;
-        A->col[diag] = d->row[i];
-        double sum = 0, known = 0;
-        for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
-            size_t j = nl->j[k];
-            if (!d->not_dummy[j])
-                continue;
-            double dx = p->pos[3 * j] - p->pos[3 * i], dy = p->pos[3 * j + 1] - p->pos[3 * i + 1],
-                   dz = p->pos[3 * j + 2] - p->pos[3 * i + 2];
-            double w = mf_weight(sqrt(dx * dx + dy * dy + dz * dz), re);
-            double cw = c * w;
-            if (rho_p)
-                cw *= mps_inv_rho_pair(rho_p[i], rho_p[j], avg);
-            sum += cw;
-            if (d->in_ppe[j]) {
-                A->col[pos] = d->row[j];
-                A->val[pos++] = -cw;
-            } else if (w > 0) {
-                touches[r] = 1; /* a Dirichlet neighbour */
-                if (pd)
-                    known += cw * pd[j];
-            }
-        }
-        if (!(sum > 0) && d->is_fluid[i]) {
-            /* n* counts dummy particles, the Laplacian does not: a fluid
-             * particle with only dummies within re is inside a wall, and its
-             * row would be zero (BoomerAMG stops on the singular system).
-             * Seen on a mesh wall, which the run's watch does not check. */
-            wall_rc = MF_ERROR(MF_ERR_NUMERIC,
-                               "unstable (throughWall) at time %g, step %ld: fluid particle id "
-                               "%lld at (%g %g %g) has only dummy particles within re: it is "
-                               "inside a wall",
-                               sim->time, sim->step, (long long)p->id[i], p->pos[3 * i],
-                               p->pos[3 * i + 1], p->pos[3 * i + 2]);
-            break;
-        }
-        /* n* - n0, or against a per-particle reference (mps_data.n_offset) */
-        const double dn = d->n_offset ? n[i] - n0 - d->n_offset[i] : n[i] - n0;
-        if (rho_p) {
-            A->val[diag] = sum + d->s.compressibility / (dt * dt);
-            d->rhs[r] = d->s.relaxation / (dt * dt) * dn / n0;
-        } else {
-            A->val[diag] = sum + d->s.compressibility * rho / (dt * dt);
-            d->rhs[r] = d->s.relaxation * rho / (dt * dt) * dn / n0;
-        }
-        if (pd)
-            d->rhs[r] += known;
-        if (!(sum > 0) && d->s.compressibility <= 0) {
-            /* A wall particle with only dummies within re: no equation
-             * couples it, so it takes p = 0 (a zero row is singular). */
-            A->val[diag] = c;
-            d->rhs[r] = 0;
-            touches[r] = 1;
-        }
-        if (d->s.compressibility > 0)
-            touches[r] = 1;
-        d->x[r] = pressure[i]; /* warm start from the last step */
+    ppe_ctx c = {
+        .d = d,
+        .sim = sim,
+        .rows = {d->row, A->row_offset, A->rowptr, A->col, A->val, global_col},
+        .c = 2.0 * d->k_lap.dim / (d->k_lap.lambda * d->k_lap.n0),
+        .dt = dt,
+        .rho = sim->fluid[0].rho,
+        .n0 = d->k_nd.n0,
+        .rho_p = d->rho,
+        .pd = d->p_dirichlet,
+        .n = mf_particles_fd(p, d->f_number_density),
+        .pressure = mf_particles_fd(p, d->f_pressure),
+        .avg = d->rho_average,
+        .touches = touches,
+    };
+    int rc = mps_pairs(d, sim, d->h_lap, &c.v);
+    c.re = c.v.radius;
+    size_t failed = SIZE_MAX;
+    if (rc == 0)
+        rc = mf_pairs_assemble(&c.v, d->row, A->rowptr, nrows, ppe_count, ppe_sized, ppe_row, &c,
+                               &failed);
+    if (rc == 0 && failed != SIZE_MAX) {
+        /* n* counts dummy particles, the Laplacian does not: a fluid
+         * particle with only dummies within re is inside a wall, and its
+         * row would be zero (BoomerAMG stops on the singular system).
+         * Seen on a mesh wall, which the run's watch does not check. */
+        const size_t i = failed;
+        rc = MF_ERROR(MF_ERR_NUMERIC,
+                      "unstable (throughWall) at time %g, step %ld: fluid particle id "
+                      "%lld at (%g %g %g) has only dummy particles within re: it is "
+                      "inside a wall",
+                      sim->time, sim->step, (long long)p->id[i], p->pos[3 * i],
+                      p->pos[3 * i + 1], p->pos[3 * i + 2]);
     }
     /* Every rank learns of a particle inside a wall before the solve. */
-    wall_rc = mf_parallel_agree(sim->par, wall_rc);
-    if (wall_rc != 0) {
+    rc = mf_parallel_agree(sim->par, rc);
+    if (rc != 0) {
         free(touches);
-        return mf_error_trace(wall_rc, __FILE__, __LINE__, __func__);
+        return mf_error_trace(rc, __FILE__, __LINE__, __func__);
     }
-    A->rowptr[nrows] = pos;
     size_t closed = 0;
-    int rc = regularise_closed_groups(d, sim, nl, touches, &closed);
+    rc = regularise_closed_groups(d, sim, &c.v, touches, &closed);
     free(touches);
     MF_CALL(rc);
-    double nclosed = (double)closed;
+    double nclosed = (double)closed; /* over the ranks */
     mf_parallel_sum(sim->par, &nclosed, 1);
     closed = (size_t)nclosed;
     if (closed)
@@ -259,10 +339,6 @@ int mps_assemble_ppe(mps_data *d, const mf_sim *sim, double dt)
     return 0;
 }
 
-/* The pressure solve did not converge (MF_RETRY from the pressure module):
- * name it as the run's watch names its criteria (pressureSolve), with the
- * time, the residuals and the particle of the largest residual, so that a
- * run stopped by it says where. Stays MF_RETRY: a smaller step may fix it. */
 /* x of another rank's row, from the copies' (global row, value) pairs. */
 typedef struct row_value {
     int64_t row;
@@ -297,8 +373,10 @@ static int worst_row(mps_data *d, const mf_sim *sim, double *rmax, size_t *parti
     const int64_t offset = A->row_offset;
     double *xp = d->grad; /* scratch, n values: the step is lost anyway */
     for (size_t i = 0; i < p->n_owned; i++)
-        xp[i] = d->row[i] >= 0 ? d->x[d->row[i] - offset] : 0.0;
+        xp[i] = d->row[i] >= 0 ? d->x[d->row[i]] : 0.0;
     MF_CALL(mps_halo_sync(d, sim, xp, sizeof *xp));
+    /* A copy's global row (on one rank an image's row is its owner's). */
+    const long *grow = sim->par ? d->row_global : d->row;
     size_t nt = 0;
     row_value *t = malloc((p->n - p->n_owned + 1) * sizeof *t);
     int rc = mf_parallel_agree(sim->par, t ? 0 : MF_ERROR(MF_ERR_MEMORY, "out of memory"));
@@ -307,15 +385,15 @@ static int worst_row(mps_data *d, const mf_sim *sim, double *rmax, size_t *parti
         return rc;
     }
     for (size_t j = p->n_owned; j < p->n; j++)
-        if (d->row[j] >= 0 && (d->row[j] < offset || d->row[j] >= offset + (int64_t)A->nrows))
-            t[nt++] = (row_value){d->row[j], xp[j]};
+        if (grow[j] >= 0 && (grow[j] < offset || grow[j] >= offset + (int64_t)A->nrows))
+            t[nt++] = (row_value){grow[j], xp[j]};
     qsort(t, nt, sizeof *t, by_row);
     *rmax = -1;
     *particle = SIZE_MAX;
     for (size_t i = 0; i < p->n_owned; i++) {
         if (d->row[i] < 0)
             continue;
-        const size_t r = (size_t)(d->row[i] - offset);
+        const size_t r = (size_t)d->row[i];
         double res = d->rhs[r];
         for (size_t k = A->rowptr[r]; k < A->rowptr[r + 1]; k++) {
             const int64_t c = A->col[k];
@@ -399,10 +477,8 @@ int mps_solve_ppe(mps_data *d, mf_sim *sim)
     if (rc != 0)
         return mf_error_trace(rc, __FILE__, __LINE__, __func__);
     double *pressure = mf_particles_fd(p, d->f_pressure);
-    const int64_t offset = d->A.row_offset;
     for (size_t i = 0; i < p->n_owned; i++) {
-        double v = d->row[i] >= 0 ? d->x[d->row[i] - offset]
-                                  : (d->p_dirichlet ? d->p_dirichlet[i] : 0.0);
+        double v = d->row[i] >= 0 ? d->x[d->row[i]] : (d->p_dirichlet ? d->p_dirichlet[i] : 0.0);
         pressure[i] = (d->s.clip_negative_pressure && v < 0) ? 0.0 : v;
     }
     MF_CALL(mps_halo_sync(d, sim, pressure, sizeof *pressure));

@@ -8,28 +8,9 @@
 #include "mf_run.h"
 #include "mps.h"
 
-static double max_radius(const mps_data *d)
+int mps_pairs(const mps_data *d, const mf_sim *sim, int handle, mf_pairs *out)
 {
-    double r = d->k_nd.re;
-    if (d->k_grad.re > r) r = d->k_grad.re;
-    if (d->k_lap.re > r) r = d->k_lap.re;
-    return r;
-}
-
-/* The list for an operator: the full list when its radius is the largest. */
-static const mf_nlist *list_for(const mps_data *d, const mf_nlist *filtered, double re)
-{
-    return re >= d->nl_max.radius ? &d->nl_max : filtered;
-}
-
-static int filter_lists(mps_data *d, const mf_particles *p)
-{
-    if (d->k_nd.re < d->nl_max.radius)
-        MF_CALL(mf_nlist_filter(&d->nl_nd, &d->nl_max, p, d->k_nd.re));
-    if (d->k_grad.re < d->nl_max.radius)
-        MF_CALL(mf_nlist_filter(&d->nl_grad, &d->nl_max, p, d->k_grad.re));
-    if (d->k_lap.re < d->nl_max.radius)
-        MF_CALL(mf_nlist_filter(&d->nl_lap, &d->nl_max, p, d->k_lap.re));
+    MF_CALL(mf_neighbours_pairs(d->nb, sim->p, handle, out));
     return 0;
 }
 
@@ -37,28 +18,22 @@ int mps_build_neighbours(mps_data *d, mf_sim *sim, bool reorder)
 {
     double t0 = mf_wall_seconds();
     mf_particles *p = sim->p;
-    const double rmax = max_radius(d);
     if (d->halo) /* drop the last copies, wrap; migrate at the start of a step */
         MF_CALL(mps_halo_begin(d, sim, reorder));
-    MF_CALL(mf_grid_build(&d->grid, p, rmax));
     if (reorder && d->s.reorder_interval > 0 && sim->step % d->s.reorder_interval == 0) {
         /* Sort along cells: neighbours become neighbours in memory too. */
-        size_t *perm = malloc(p->n * sizeof *perm);
+        size_t *perm = malloc((p->n ? p->n : 1) * sizeof *perm);
         if (!perm)
             return MF_ERROR(MF_ERR_MEMORY, "out of memory reordering particles");
-        int rc = mf_grid_locality_order(&d->grid, perm);
+        int rc = mf_neighbours_locality_order(d->nb, p, d->h_max, perm);
         if (rc == 0)
             rc = mf_particles_permute(p, perm);
         free(perm);
         MF_CALL(rc);
-        MF_CALL(mf_grid_build(&d->grid, p, rmax));
     }
-    if (d->halo) { /* copies from other ranks and across the period, then the grid again */
+    if (d->halo) /* copies from other ranks and across the period */
         MF_CALL(mps_halo_add(d, sim, !reorder)); /* reorder: the build at r^n */
-        MF_CALL(mf_grid_build(&d->grid, p, rmax));
-    }
-    MF_CALL(mf_nlist_build(&d->nl_max, &d->grid, p, rmax));
-    MF_CALL(filter_lists(d, p));
+    MF_CALL(mf_neighbours_update(d->nb, p, d->h_max));
     d->t_neighbours += mf_wall_seconds() - t0;
     return 0;
 }
@@ -71,48 +46,23 @@ void mps_set_masks(mps_data *d, const mf_particles *p)
     }
 }
 
-/* Optional collision model (Koshizuka lab's MPS codes): approaching pairs
- * closer than the collision distance exchange momentum with restitution e. */
-static void collide(mps_data *d, mf_sim *sim, double dt)
+/* Optional collision model (Koshizuka lab's MPS codes, mf_collision):
+ * approaching pairs closer than the collision distance exchange momentum
+ * with restitution e; positions follow the velocity change. */
+static int collide(mps_data *d, mf_sim *sim, double dt)
 {
     mf_particles *p = sim->p;
-    const mf_nlist *nl = list_for(d, &d->nl_grad, d->k_grad.re);
-    const double dc = d->s.collision_distance * sim->l0, e = d->s.restitution;
-    for (size_t i = 0; i < p->n_owned; i++) {
-        if (!d->is_fluid[i])
-            continue;
-        double *vi = &d->grad[3 * i]; /* scratch: new velocity of i */
-        memcpy(vi, &p->vel[3 * i], 3 * sizeof(double));
-        for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
-            size_t j = nl->j[k];
-            double r[3], r2 = 0;
-            for (int c = 0; c < 3; c++) {
-                r[c] = p->pos[3 * j + c] - p->pos[3 * i + c];
-                r2 += r[c] * r[c];
-            }
-            if (r2 >= dc * dc || r2 <= 0)
-                continue;
-            double len = sqrt(r2), approach = 0;
-            for (int c = 0; c < 3; c++)
-                approach += (vi[c] - p->vel[3 * j + c]) * r[c] / len;
-            if (approach <= 0)
-                continue;
-            /* Equal masses (one fluid) or masses in proportion to the
-             * densities (mps_data.rho); a wall (fixed) counts as
-             * infinitely heavy. */
-            double share = !d->is_fluid[j] ? 1.0
-                           : d->rho         ? d->rho[j] / (d->rho[i] + d->rho[j])
-                                            : 0.5;
-            for (int c = 0; c < 3; c++)
-                vi[c] -= share * (1 + e) * approach * r[c] / len;
-        }
-    }
+    mf_pairs v;
+    MF_CALL(mps_pairs(d, sim, d->h_coll, &v));
+    double *vnew = d->grad; /* scratch: the new velocities */
+    mf_collision(&v, d->is_fluid, d->rho, d->s.restitution, p->vel, vnew);
     for (size_t i = 0; i < p->n_owned; i++)
         if (d->is_fluid[i])
             for (int c = 0; c < 3; c++) {
-                p->pos[3 * i + c] += dt * (d->grad[3 * i + c] - p->vel[3 * i + c]);
-                p->vel[3 * i + c] = d->grad[3 * i + c];
+                p->pos[3 * i + c] += dt * (vnew[3 * i + c] - p->vel[3 * i + c]);
+                p->vel[3 * i + c] = vnew[3 * i + c];
             }
+    return 0;
 }
 
 /* eqs. 9-10: u* = u + dt (nu lap u + forces), r* = r + dt u*. With a
@@ -125,27 +75,20 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
     mf_particles *p = sim->p;
     const double nu = sim->fluid[0].nu;
     memset(d->acc, 0, 3 * p->n * sizeof *d->acc);
-    sim->neighbours = &d->nl_max; /* at r^n: forces that need neighbours use it */
     for (size_t k = 0; k < sim->nforces; k++) {
         const mf_force_ops *ops = (const mf_force_ops *)sim->forces[k].info;
-        int rc = ops->accumulate(sim->forces[k].data, sim, d->acc);
-        if (rc != 0) {
-            sim->neighbours = NULL;
-            return mf_error_trace(rc, __FILE__, __LINE__, __func__);
-        }
+        MF_CALL(ops->accumulate(sim->forces[k].data, sim, d->acc));
     }
-    sim->neighbours = NULL;
     if (d->visc) { /* viscosity implicit: u* = (I - dt nu lap)^-1 (u + dt a), r* = r + dt u* */
         MF_CALL(mps_viscosity_implicit(d, sim, dt));
-    } else if (d->mu) {
-        mps_viscous_pairs(d, p, list_for(d, &d->nl_lap, d->k_lap.re), d->acc);
-    } else if (nu > 0) {
-        const mf_nlist *nl = list_for(d, &d->nl_lap, d->k_lap.re);
-        mf_laplacian(p, nl, &d->k_lap, p->vel, 3, d->is_fluid, NULL, d->grad);
-        for (size_t i = 0; i < p->n_owned; i++)
-            if (d->is_fluid[i])
-                for (int c = 0; c < 3; c++)
-                    d->acc[3 * i + c] += nu * d->grad[3 * i + c];
+    } else if (d->mu || nu > 0) {
+        mf_pairs v;
+        MF_CALL(mps_pairs(d, sim, d->h_lap, &v));
+        if (d->mu) /* eq. 27: each pair through mu_ij, walls and dummies with mu_i */
+            mf_laplacian_mu(&v, &d->k_lap, p->vel, d->mu, d->mu_average, d->is_fluid, d->rho,
+                            d->is_fluid, d->acc);
+        else
+            mf_laplacian_add(&v, &d->k_lap, p->vel, nu, d->is_fluid, NULL, d->acc);
     }
     for (size_t i = 0; i < p->n_owned && !d->visc; i++) {
         if (!d->is_fluid[i])
@@ -158,7 +101,7 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
     if (d->halo) /* copies move with their owners (the collision model reads them) */
         MF_CALL(mps_halo_sync_motion(d, sim));
     if (d->s.collision)
-        collide(d, sim, dt);
+        MF_CALL(collide(d, sim, dt));
     d->t_explicit += mf_wall_seconds() - t0;
     return 0;
 }
@@ -170,7 +113,9 @@ int mps_surface_phase(mps_data *d, mf_sim *sim)
     mf_particles *p = sim->p;
     double *n = mf_particles_fd(p, d->f_number_density);
     int32_t *flags = mf_particles_fi(p, d->f_flags);
-    mf_number_density(p, list_for(d, &d->nl_nd, d->k_nd.re), d->not_dummy, NULL, n);
+    mf_pairs v;
+    MF_CALL(mps_pairs(d, sim, d->h_nd, &v));
+    mf_number_density(&v, d->not_dummy, NULL, n);
     const double n0 = d->k_nd.n0;
     for (size_t i = 0; i < p->n_owned; i++) {
         bool surface = d->not_dummy[i] && n[i] < d->s.beta * n0;
@@ -212,13 +157,14 @@ int mps_correction_phase(mps_data *d, mf_sim *sim, double dt)
     mf_particles *p = sim->p;
     const double *pr = mf_particles_fd(p, d->f_pressure);
     if (d->rho) { /* a density per particle: 1/rho_ij in the sum */
-        mps_gradient_pairs(d, p, pr, NULL);
+        MF_CALL(mps_gradient_pairs(d, sim, pr, NULL));
         mps_apply_correction(d, p, dt, NULL);
         d->t_correction += mf_wall_seconds() - t0;
         return 0;
     }
-    mf_gradient(p, list_for(d, &d->nl_grad, d->k_grad.re), &d->k_grad, pr, d->s.gradient_pmin,
-                d->is_fluid, d->not_dummy, d->grad);
+    mf_pairs v;
+    MF_CALL(mps_pairs(d, sim, d->h_grad, &v));
+    mf_gradient(&v, &d->k_grad, pr, d->s.gradient_pmin, d->is_fluid, d->not_dummy, d->grad);
     const double rho = sim->fluid[0].rho;
     for (size_t i = 0; i < p->n_owned; i++) {
         if (!d->is_fluid[i])
@@ -232,7 +178,7 @@ int mps_correction_phase(mps_data *d, mf_sim *sim, double dt)
     if (d->s.collision && d->s.collision_after_correction) {
         if (d->halo) /* the corrected motion of the copies' owners */
             MF_CALL(mps_halo_sync_motion(d, sim));
-        collide(d, sim, dt);
+        MF_CALL(collide(d, sim, dt));
     }
     d->t_correction += mf_wall_seconds() - t0;
     return 0;

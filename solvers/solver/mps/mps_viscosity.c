@@ -34,6 +34,7 @@ typedef struct mps_viscosity {
     mf_csr A;
     double *b, *x;
     long *row; /* particle -> row, -1: not an unknown */
+    long *row_global; /* on several ranks: particle -> global row (copies: their owners') */
     size_t cap_p, cap_rows, cap_nnz;
     long solves, iterations;
     double seconds;
@@ -75,6 +76,7 @@ void mps_viscosity_destroy(mps_viscosity *v)
     free(v->b);
     free(v->x);
     free(v->row);
+    free(v->row_global);
     free(v);
 }
 
@@ -83,9 +85,13 @@ static int reserve(mps_viscosity *v, size_t np, size_t rows, size_t nnz)
     if (np > v->cap_p) {
         size_t cap = np + np / 4 + 64;
         long *row = realloc(v->row, cap * sizeof *row);
-        if (!row)
+        if (row)
+            v->row = row;
+        long *global = row ? realloc(v->row_global, cap * sizeof *global) : NULL;
+        if (global)
+            v->row_global = global;
+        if (!row || !global)
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu particles", np);
-        v->row = row;
         v->cap_p = cap;
     }
     if (rows + 1 > v->cap_rows) {
@@ -104,8 +110,8 @@ static int reserve(mps_viscosity *v, size_t np, size_t rows, size_t nnz)
         v->cap_rows = cap;
     }
     if (nnz > v->cap_nnz) {
-        size_t cap = nnz + nnz / 4 + 64;
-        int64_t *col = realloc(v->A.col, cap * sizeof *col);
+        size_t cap = nnz + nnz / 16 + 64;
+        int32_t *col = realloc(v->A.col, cap * sizeof *col);
         if (col)
             v->A.col = col;
         double *val = realloc(v->A.val, cap * sizeof *val);
@@ -118,57 +124,93 @@ static int reserve(mps_viscosity *v, size_t np, size_t rows, size_t nnz)
     return 0;
 }
 
-/* The pair term of row i: dt c mu_ij w_ij (mu_ij = nu with one fluid). */
-static inline double pair_coef(const mps_data *d, size_t i, size_t j, bool j_fluid, double nu,
-                               double dtc, double w)
+/* One row of the matrix (the header's A_ii, A_ij) from the pair engine's
+ * assemble sink: the coefficient kernel is dt c mu_ij w_ij (mu_ij = nu with
+ * one fluid); a wall or dummy neighbour's velocity is a known value. */
+typedef struct visc_ctx {
+    const mps_data *d;
+    mf_pairs v;
+    mf_rows rows;
+    const double *vel;
+    double nu, dtc, re;
+    double *dirichlet; /* 3 per row: sum of dt c mu_ij w_ij u_j over the known j */
+} visc_ctx;
+
+static inline bool visc_takes_part(const void *ctx, const mf_pair *pr)
 {
+    const visc_ctx *c = ctx;
+    return mf_weight(pr->len, c->re) > 0.0;
+}
+
+static inline double visc_coef(const void *ctx, const mf_pair *pr)
+{
+    const visc_ctx *c = ctx;
+    const mps_data *d = c->d;
+    const double w = mf_weight(pr->len, c->re);
     if (!d->mu)
-        return dtc * nu * w;
-    const double mu_ij = j_fluid ? mps_mu_pair(d->mu[i], d->mu[j], d->mu_average) : d->mu[i];
-    return dtc * mu_ij * w;
+        return c->dtc * c->nu * w;
+    const size_t i = pr->i, j = pr->j;
+    const double mu_ij = d->is_fluid[j] ? mf_mu_pair(d->mu[i], d->mu[j], d->mu_average) : d->mu[i];
+    return c->dtc * mu_ij * w;
+}
+
+static inline void visc_known(void *acc, const void *ctx, const mf_pair *pr, double a)
+{
+    const visc_ctx *c = ctx;
+    double *known = acc;
+    for (int q = 0; q < 3; q++)
+        known[q] += a * c->vel[3 * pr->j + q];
+}
+
+static bool visc_row(const void *ctx, size_t i, size_t r)
+{
+    const visc_ctx *c = ctx;
+    const mps_data *d = c->d;
+    double known[3] = {0.0, 0.0, 0.0};
+    const double sum = mf_pairs_row_assemble(&c->v, i, NULL, visc_takes_part, visc_coef,
+                                             visc_known, c, known, &c->rows, r);
+    d->visc->A.val[c->rows.rowptr[r]] = (d->rho ? d->rho[i] : 1.0) + sum;
+    memcpy(&c->dirichlet[3 * r], known, sizeof known);
+    return true;
+}
+
+static size_t visc_count(const void *ctx, size_t i)
+{
+    const visc_ctx *c = ctx;
+    return mf_pairs_row_count(&c->v, i, NULL, visc_takes_part, c, c->rows.col_of);
+}
+
+static int visc_sized(void *ctx, size_t nnz)
+{
+    visc_ctx *c = ctx;
+    mps_viscosity *v = c->d->visc;
+    MF_CALL(reserve(v, 0, v->A.nrows, nnz));
+    c->rows.rowptr = v->A.rowptr;
+    c->rows.col = v->A.col;
+    c->rows.val = v->A.val;
+    return 0;
 }
 
 /* Matrix of the fluid rows and, in dirichlet (3 per row), the wall
  * contributions dt c mu_ij w_ij u_j. */
-static int assemble(mps_data *d, const mf_sim *sim, double dt, double *dirichlet)
+static int assemble(mps_data *d, const mf_sim *sim, double dt, double *dirichlet,
+                    const long *global_col)
 {
     mps_viscosity *v = d->visc;
-    const mf_particles *p = sim->p;
-    const mf_nlist *nl = d->k_lap.re >= d->nl_max.radius ? &d->nl_max : &d->nl_lap;
-    const double re = nl->radius, nu = sim->fluid[0].nu;
-    const double dtc = dt * 2.0 * d->k_lap.dim / (d->k_lap.lambda * d->k_lap.n0);
     mf_csr *A = &v->A;
-    size_t pos = 0;
-    for (size_t i = 0; i < p->n_owned; i++) {
-        if (!d->is_fluid[i])
-            continue;
-        size_t r = (size_t)(v->row[i] - A->row_offset);
-        A->rowptr[r] = pos;
-        size_t diag = pos++;
-        A->col[diag] = v->row[i];
-        double sum = 0.0, known[3] = {0.0, 0.0, 0.0};
-        for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
-            size_t j = nl->j[k];
-            double dx = p->pos[3 * j] - p->pos[3 * i], dy = p->pos[3 * j + 1] - p->pos[3 * i + 1],
-                   dz = p->pos[3 * j + 2] - p->pos[3 * i + 2];
-            double w = mf_weight(sqrt(dx * dx + dy * dy + dz * dz), re);
-            if (w <= 0.0)
-                continue;
-            const bool fluid = d->is_fluid[j];
-            double a = pair_coef(d, i, j, fluid, nu, dtc, w);
-            sum += a;
-            if (fluid) {
-                A->col[pos] = v->row[j]; /* global: a copy holds its owner's */
-                A->val[pos++] = -a;
-            } else {
-                for (int c = 0; c < 3; c++)
-                    known[c] += a * p->vel[3 * j + c];
-            }
-        }
-        A->val[diag] = (d->rho ? d->rho[i] : 1.0) + sum;
-        memcpy(&dirichlet[3 * r], known, sizeof known);
-    }
-    A->rowptr[A->nrows] = pos;
+    visc_ctx c = {
+        .d = d,
+        .rows = {v->row, A->row_offset, A->rowptr, A->col, A->val, global_col},
+        .vel = sim->p->vel,
+        .nu = sim->fluid[0].nu,
+        .dtc = dt * 2.0 * d->k_lap.dim / (d->k_lap.lambda * d->k_lap.n0),
+        .dirichlet = dirichlet,
+    };
+    MF_CALL(mps_pairs(d, sim, d->h_lap, &c.v));
+    c.re = c.v.radius;
+    size_t failed;
+    MF_CALL(mf_pairs_assemble(&c.v, v->row, A->rowptr, A->nrows, visc_count, visc_sized, visc_row,
+                              &c, &failed));
     return 0;
 }
 
@@ -176,33 +218,37 @@ int mps_viscosity_implicit(mps_data *d, mf_sim *sim, double dt)
 {
     mps_viscosity *v = d->visc;
     mf_particles *p = sim->p;
-    const mf_nlist *nl = d->k_lap.re >= d->nl_max.radius ? &d->nl_max : &d->nl_lap;
-    size_t rows = 0, nnz = 0;
+    size_t rows = 0;
     MF_CALL(reserve(v, p->n, 0, 0));
-    for (size_t i = 0; i < p->n_owned; i++) {
+    for (size_t i = 0; i < p->n_owned; i++)
         v->row[i] = d->is_fluid[i] ? (long)rows++ : -1;
-        if (d->is_fluid[i])
-            nnz += 1 + (nl->start[i + 1] - nl->start[i]);
-    }
-    /* Global rows; copies (images, other ranks' particles) take their owners'. */
+    /* Rows over the ranks; copies (images, other ranks' particles) are their
+     * owners' unknowns. */
     int64_t offset = 0, nglobal = 0;
-    MF_CALL(mps_global_rows(d, sim, v->row, rows, &offset, &nglobal));
-    MF_CALL(reserve(v, p->n, rows, nnz));
+    const long *global_col = NULL;
+    MF_CALL(mps_global_rows(d, sim, v->row, rows, v->row_global, &offset, &nglobal,
+                            &global_col));
+    if (nglobal > MF_CSR_MAX_GLOBAL)
+        return MF_ERROR(MF_ERR_INPUT,
+                        "%lld viscous unknowns: the matrix's columns are 32-bit (hypre's "
+                        "HYPRE_BigInt), at most %d in all",
+                        (long long)nglobal, MF_CSR_MAX_GLOBAL);
+    MF_CALL(reserve(v, p->n, rows, 0)); /* the entries: counted by assemble */
     v->A.nrows = rows;
     v->A.row_offset = offset;
     v->A.nglobal = nglobal;
     double *dirichlet = malloc(3 * (rows ? rows : 1) * sizeof *dirichlet);
     if (!dirichlet)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu viscous unknowns", rows);
-    int rc = assemble(d, sim, dt, dirichlet);
+    int rc = assemble(d, sim, dt, dirichlet, global_col);
     static const char *const names[3] = {"Ux", "Uy", "Uz"};
     const double t0 = mf_wall_seconds();
     for (int c = 0; rc == 0 && c < sim->dim; c++) {
         /* b = rho_i (u^n + dt a) + walls; the guess: u^n + dt a. */
         for (size_t i = 0; i < p->n_owned; i++) {
-            if (v->row[i] < 0)
+            long r = v->row[i];
+            if (r < 0)
                 continue;
-            const long r = v->row[i] - (long)offset;
             const double ut = p->vel[3 * i + c] + dt * d->acc[3 * i + c];
             v->x[r] = ut;
             v->b[r] = (d->rho ? d->rho[i] : 1.0) * ut + dirichlet[3 * r + c];
@@ -219,7 +265,7 @@ int mps_viscosity_implicit(mps_data *d, mf_sim *sim, double dt)
         if (rc == 0)
             for (size_t i = 0; i < p->n_owned; i++)
                 if (v->row[i] >= 0)
-                    p->vel[3 * i + c] = v->x[v->row[i] - offset];
+                    p->vel[3 * i + c] = v->x[v->row[i]];
     }
     v->seconds += mf_wall_seconds() - t0;
     free(dirichlet);

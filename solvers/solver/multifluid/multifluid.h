@@ -73,7 +73,7 @@ int multifluid_reserve(multifluid_data *d, size_t n);
 
 /* multifluid_step.c: density, light density and viscosity per particle
  * (walls: the w-weighted mean density of their fluid neighbours). */
-void multifluid_fill_properties(multifluid_data *d, const mf_sim *sim);
+int multifluid_fill_properties(multifluid_data *d, const mf_sim *sim);
 int multifluid_step(multifluid_data *d, mf_sim *sim, double dt);
 
 /* multifluid_pressure.c: the iterative two-step pressure (section 3.4). */

@@ -80,10 +80,10 @@ static int setup_fluids(multifluid_data *d, mf_sim *sim)
     for (int k = 0; k < sim->nfluids; k++)
         d->heavy[k] = d->iterative && sim->fluid[k].rho >= d->s.ratio_threshold * d->rho_min;
     mps_data *m = d->mps;
-    m->rho_average = strcmp(d->s.density_average, "harmonic") == 0 ? MPS_AVERAGE_HARMONIC
-                                                                   : MPS_AVERAGE_ARITHMETIC;
-    m->mu_average = strcmp(d->s.viscosity_average, "arithmetic") == 0 ? MPS_AVERAGE_ARITHMETIC
-                                                                      : MPS_AVERAGE_HARMONIC;
+    m->rho_average = strcmp(d->s.density_average, "harmonic") == 0 ? MF_AVERAGE_HARMONIC
+                                                                   : MF_AVERAGE_ARITHMETIC;
+    m->mu_average = strcmp(d->s.viscosity_average, "arithmetic") == 0 ? MF_AVERAGE_ARITHMETIC
+                                                                      : MF_AVERAGE_HARMONIC;
     if (d->iterative)
         MF_CALL(mf_particles_request_field(sim->p, "LightPressure", 1, MF_FIELD_DOUBLE, true,
                                            &d->f_light_pressure));

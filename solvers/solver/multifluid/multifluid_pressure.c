@@ -36,28 +36,37 @@
 #include "mf_run.h"
 #include "multifluid.h"
 
+/* Does i touch a heavy particle? (stops at the first) */
+static inline bool heavy_pair(void *acc, const void *ctx, const mf_pair *pr)
+{
+    const multifluid_data *d = ctx;
+    if (!d->heavy_mask[pr->j])
+        return true;
+    *(bool *)acc = true;
+    return false;
+}
+
 /* The heavy solve's unknowns: heavy fluid particles and walls touching one,
  * among the unknowns of the full system (not free surface, not dummy). */
-static size_t set_heavy_unknowns(multifluid_data *d, const mf_sim *sim)
+static int set_heavy_unknowns(multifluid_data *d, const mf_sim *sim, size_t *count)
 {
     mps_data *m = d->mps;
     const mf_particles *p = sim->p;
-    const mf_nlist *nl = m->k_lap.re >= m->nl_max.radius ? &m->nl_max : &m->nl_lap;
-    size_t count = 0;
+    mf_pairs v;
+    MF_CALL(mps_pairs(m, sim, m->h_lap, &v));
+    *count = 0;
     for (size_t i = 0; i < p->n_owned; i++) {
         bool in = false;
         if (d->in_all[i]) {
-            if (p->kind[i] == MF_FLUID) {
+            if (p->kind[i] == MF_FLUID)
                 in = d->heavy_mask[i];
-            } else {
-                for (size_t k = nl->start[i]; k < nl->start[i + 1] && !in; k++)
-                    in = d->heavy_mask[nl->j[k]];
-            }
+            else
+                mf_pairs_row_r2(&v, i, NULL, heavy_pair, d, &in);
         }
         m->in_ppe[i] = in;
-        count += in;
+        *count += in;
     }
-    return count;
+    return 0;
 }
 
 /* "p_<name>" when a group is one fluid, else "p_light" / "p_heavy". */
@@ -129,9 +138,11 @@ static int rounds(multifluid_data *d, mf_sim *sim, double dt, long *made, double
     solve_names(d, sim, name_light, name_heavy, sizeof name_light);
     MF_CALL(mps_surface_phase(m, sim)); /* at r*: number density, free surface */
     memcpy(d->in_all, m->in_ppe, n);
-    double global_rows = (double)set_heavy_unknowns(d, sim); /* fills m->in_ppe */
+    size_t rows = 0;
+    MF_CALL(set_heavy_unknowns(d, sim, &rows)); /* fills m->in_ppe */
+    double global_rows = (double)rows;
     mf_parallel_sum(sim->par, &global_rows, 1); /* every rank solves, or none */
-    const size_t rows = (size_t)global_rows;
+    rows = (size_t)global_rows;
     memcpy(d->heavy_rows, m->in_ppe, n);
     memcpy(d->p_prev, P, n * sizeof *P);
     *made = 0;
@@ -164,9 +175,9 @@ static int rounds(multifluid_data *d, mf_sim *sim, double dt, long *made, double
         double tc = mf_wall_seconds();
         memcpy(d->grad_prev, m->grad, 3 * n * sizeof *m->grad);
         m->rho = k == 1 ? d->rho_light : d->rho;
-        mps_gradient_pairs(m, p, pl, d->light_mask);
+        MF_CALL(mps_gradient_pairs(m, sim, pl, d->light_mask));
         m->rho = d->rho;
-        mps_gradient_pairs(m, p, P, d->heavy_mask);
+        MF_CALL(mps_gradient_pairs(m, sim, P, d->heavy_mask));
         double change = 0;
         for (size_t i = 0; i < n; i++) {
             if (!d->light_mask[i] && !d->heavy_mask[i])

@@ -5,18 +5,42 @@
 #include "mf_error.h"
 #include "multifluid.h"
 
+/* A wall's density: the w-weighted mean density of its fluid neighbours. */
+typedef struct wall_rho_ctx {
+    const mf_sim *sim;
+    const int32_t *fid;
+    double re;
+} wall_rho_ctx;
+
+typedef struct wall_rho_acc {
+    double sw, swr;
+} wall_rho_acc;
+
+static inline bool wall_rho_pair(void *acc, const void *ctx, const mf_pair *pr)
+{
+    const wall_rho_ctx *c = ctx;
+    wall_rho_acc *a = acc;
+    if (c->sim->p->kind[pr->j] != MF_FLUID)
+        return true;
+    const double w = mf_weight(pr->len, c->re);
+    a->sw += w;
+    a->swr += w * c->sim->fluid[c->fid[pr->j]].rho;
+    return true;
+}
+
 /* Density and viscosity per particle from FluidId. A wall takes the
  * w-weighted mean density of its fluid neighbours (the heaviest fluid's
  * when it has none), so that a wall under water is water to the PPE and a
  * wall in air is air; its viscosity is not used (a wall takes that of the
  * fluid particle it touches). rho_light: every heavy particle as the
  * lightest fluid (the first solve of the iterative pressure). */
-void multifluid_fill_properties(multifluid_data *d, const mf_sim *sim)
+int multifluid_fill_properties(multifluid_data *d, const mf_sim *sim)
 {
     const mf_particles *p = sim->p;
     const int32_t *fid = mf_particles_fi(p, d->f_fluid);
-    const mf_nlist *nl = &d->mps->nl_max;
-    const double re = nl->radius;
+    mf_pairs v;
+    MF_CALL(mps_pairs(d->mps, sim, d->mps->h_max, &v));
+    const wall_rho_ctx c = {sim, fid, v.radius};
     for (size_t i = 0; i < p->n; i++) {
         if (p->kind[i] == MF_FLUID) {
             const mf_fluid *f = &sim->fluid[fid[i]];
@@ -25,27 +49,16 @@ void multifluid_fill_properties(multifluid_data *d, const mf_sim *sim)
             d->rho_light[i] = d->heavy[fid[i]] ? d->rho_min : f->rho;
             continue;
         }
-        double sw = 0, swr = 0;
-        if (i < nl->n)
-            for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
-                size_t j = nl->j[k];
-                if (p->kind[j] != MF_FLUID)
-                    continue;
-                double r2 = 0;
-                for (int c = 0; c < 3; c++) {
-                    double dx = p->pos[3 * j + c] - p->pos[3 * i + c];
-                    r2 += dx * dx;
-                }
-                double w = mf_weight(sqrt(r2), re);
-                sw += w;
-                swr += w * sim->fluid[fid[j]].rho;
-            }
-        d->rho[i] = sw > 0 ? swr / sw : d->rho_max;
+        wall_rho_acc a = {0, 0};
+        if (i < v.ni)
+            mf_pairs_row(&v, i, NULL, wall_rho_pair, &c, &a);
+        d->rho[i] = a.sw > 0 ? a.swr / a.sw : d->rho_max;
         d->mu[i] = 0;
         /* In the light solve every particle is light: the wall's fluid
          * neighbours are, so is the wall. */
         d->rho_light[i] = d->iterative ? fmin(d->rho[i], d->rho_min) : d->rho[i];
     }
+    return 0;
 }
 
 /* The copies' densities and viscosities are their owners' (a wall copy's
@@ -104,7 +117,7 @@ static int step_phases(multifluid_data *d, mf_sim *sim, double dt)
     MF_CALL(mps_build_neighbours(m, sim, true)); /* at r^n; may reorder or migrate particles */
     MF_CALL(multifluid_reserve(d, p->n));
     mps_set_masks(m, p);
-    multifluid_fill_properties(d, sim);
+    MF_CALL(multifluid_fill_properties(d, sim));
     MF_CALL(sync_properties(d, sim));
     m->rho = d->rho;
     m->mu = d->mu;

@@ -45,8 +45,9 @@ int multifluid_surface_correction(multifluid_data *d, mf_sim *sim, double dt)
     mps_data *m = d->mps;
     const double *pr = mf_particles_fd(sim->p, m->f_pressure);
     m->own_reference = m->dirichlet; /* p^_i = p_i on the free surface */
-    mps_gradient_pairs(m, sim->p, pr, NULL);
+    int rc = mps_gradient_pairs(m, sim, pr, NULL);
     m->own_reference = NULL;
+    MF_CALL(rc);
     mps_apply_correction(m, sim->p, dt, NULL);
     return 0;
 }

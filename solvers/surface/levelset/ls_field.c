@@ -298,6 +298,10 @@ static inline double pair_d2(const ls_field *f, size_t i, double dx, double dy, 
     return f->c2[i] * r2 + f->c1[i] * along * along;
 }
 
+/* Not a particle-pair loop and not core's neighbour service: the level set's
+ * nodes (integer grid coordinates) against the particles binned into its
+ * bricks, each with its own (anisotropic) support; the service's lists are
+ * of particles around particles. */
 double ls_field_at(const ls_field *f, int32_t cand, int32_t x, int32_t y, int32_t z)
 {
     double sum = 0;

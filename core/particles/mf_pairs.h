@@ -1,0 +1,330 @@
+/* mf_pairs.h: the pair engine. Every loop over particle pairs in the code is
+ * one of the loops below; the physics of a pair is a small function (a pair
+ * kernel) that the loop is handed (STYLE.md, "The shape of a pair kernel").
+ *
+ *   mf_pairs_row       the pairs (i, j) of one particle i, j in a neighbour
+ *                      view (mf_neighbours_pairs) and in jmask, closer than
+ *                      the view's radius, in the view's order: the kernel
+ *                      adds to a per-i accumulator (the apply sink);
+ *   mf_pairs_each      the rows of the owned particles i in imask, in
+ *                      parallel (OpenMP): the operator's row function calls
+ *                      mf_pairs_row and stores its result;
+ *   mf_pairs_row_count / mf_pairs_row_assemble / mf_pairs_assemble
+ *                      matrix rows from a coefficient kernel a_ij (the
+ *                      assemble sink): diagonal first, -a_ij for a neighbour
+ *                      with a column, a known value otherwise;
+ *   mf_grid_near       the particles of a grid near any point (point
+ *                      queries: MPS-MAFL's grid points and lattice sites).
+ *
+ * The i-loop covers owned particles [0, n_owned); j runs over any particle
+ * of the view, halo and periodic images [n_owned, n) included, so that the
+ * kernels need not know about them (DESIGN.md section 9).
+ *
+ * Loops are static inline and always inlined, and take the kernel as a
+ * function: called with a literal kernel, each loop compiles to its own
+ * specialised code, as nlist.c does with its literal arguments (no macro
+ * stamping). A kernel sees the pair as mf_pair: r_ij = r_j - r_i computed
+ * from the positions exactly as the list build does, |r_ij|^2 and |r_ij|.
+ */
+#ifndef MF_PAIRS_H
+#define MF_PAIRS_H
+
+#include <math.h>
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "mf_neighbours.h"
+#include "mf_particles.h"
+
+#define MF_ENGINE static inline __attribute__((always_inline))
+
+/* A neighbour view: lists and the radius of one request. */
+typedef struct mf_pairs {
+    const double *pos;       /* 3 per particle */
+    const uint32_t *start;   /* CSR over the particles: j's of i at j[start[i] .. start[i+1]) */
+    const uint32_t *j;
+    double radius, r2;       /* pairs with |r_ij|^2 < r2 = radius * radius */
+    size_t ni;               /* i in [0, ni): the owned particles */
+    size_t n;                /* particles the lists cover */
+} mf_pairs;
+
+/* A view of a list built by hand (tests, tools): pairs closer than radius
+ * (at most the list's). */
+static inline mf_pairs mf_pairs_of_list(const mf_particles *p, const mf_nlist *nl,
+                                        double radius)
+{
+    mf_pairs v = {p->pos, nl->start, nl->j, radius, radius * radius, p->n_owned, nl->n};
+    return v;
+}
+
+typedef struct mf_pair {
+    size_t i, j;
+    double r[3];  /* r_ij = r_j - r_i */
+    double r2;    /* |r_ij|^2 = (x^2 + y^2) + z^2 */
+    double len;   /* |r_ij| */
+} mf_pair;
+
+/* Entry k of the view as the pair (xi, yi, zi: i's position): false when
+ * it is not closer than the view's radius. r_ij = r_j - r_i and |r_ij|^2 =
+ * (x^2 + y^2) + z^2 exactly as the list build computes them (z = 0 in 2-D),
+ * so that the view's pairs are the list build's at that radius. */
+MF_ENGINE bool mf_pairs_entry_as(const mf_pairs *v, uint32_t k, double xi, double yi,
+                                 double zi, mf_pair *pr, bool with_len)
+{
+    const size_t j = v->j[k];
+    const double *xj = v->pos + 3 * j;
+    const double dx = xj[0] - xi, dy = xj[1] - yi, dz = xj[2] - zi;
+    const double r2 = dx * dx + dy * dy + dz * dz;
+    if (!(r2 < v->r2))
+        return false;
+    pr->j = j;
+    pr->r[0] = dx;
+    pr->r[1] = dy;
+    pr->r[2] = dz;
+    pr->r2 = r2;
+    pr->len = with_len ? sqrt(r2) : NAN;
+    return true;
+}
+
+MF_ENGINE bool mf_pairs_entry(const mf_pairs *v, uint32_t k, double xi, double yi, double zi,
+                              mf_pair *pr)
+{
+    return mf_pairs_entry_as(v, k, xi, yi, zi, pr, true);
+}
+
+/* Adds one pair to the accumulator acc; returns false to end the row. */
+typedef bool (*mf_pair_kernel)(void *acc, const void *ctx, const mf_pair *pr);
+
+/* The pairs of particle i (see the top); with_len a literal. */
+MF_ENGINE void mf_pairs_row_as(const mf_pairs *v, size_t i, const uint8_t *jmask,
+                               mf_pair_kernel kernel, const void *ctx, void *acc, bool with_len)
+{
+    /* A local copy: its fields stay in registers across the kernel's calls. */
+    const mf_pairs w = *v;
+    const double *pos = w.pos;
+    const double xi = pos[3 * i], yi = pos[3 * i + 1], zi = pos[3 * i + 2];
+    mf_pair pr;
+    pr.i = i;
+    for (uint32_t k = w.start[i], end = w.start[i + 1]; k < end; k++) {
+        if (jmask && !jmask[w.j[k]])
+            continue;
+        if (mf_pairs_entry_as(&w, k, xi, yi, zi, &pr, with_len) && !kernel(acc, ctx, &pr))
+            break;
+    }
+}
+
+/* The pairs of particle i (see the top). */
+MF_ENGINE void mf_pairs_row(const mf_pairs *v, size_t i, const uint8_t *jmask,
+                            mf_pair_kernel kernel, const void *ctx, void *acc)
+{
+    mf_pairs_row_as(v, i, jmask, kernel, ctx, acc, true);
+}
+
+/* The same for a kernel that reads r_ij and |r_ij|^2 only (a minimum, a
+ * count, a distance test): no square root (len is NaN). */
+MF_ENGINE void mf_pairs_row_r2(const mf_pairs *v, size_t i, const uint8_t *jmask,
+                               mf_pair_kernel kernel, const void *ctx, void *acc)
+{
+    mf_pairs_row_as(v, i, jmask, kernel, ctx, acc, false);
+}
+
+/* Computes and stores the result of particle i. */
+typedef void (*mf_row_fn)(const void *ctx, size_t i);
+
+/* row(ctx, i) for the owned particles i in imask (NULL: all), in parallel. */
+MF_ENGINE void mf_pairs_each(const mf_pairs *v, const uint8_t *imask, mf_row_fn row,
+                             const void *ctx)
+{
+    const long n = (long)v->ni;
+#pragma omp parallel for schedule(static)
+    for (long i = 0; i < n; i++)
+        if (!imask || imask[i])
+            row(ctx, (size_t)i);
+}
+
+/* ---- the assemble sink ------------------------------------------------- */
+
+/* Rows of a sparse matrix (CSR, global columns) being assembled. */
+typedef struct mf_rows {
+    const long *col_of;  /* particle -> local column (>= 0), or -1: a known value */
+    int64_t col_offset;  /* global column = col_offset + col_of[j] ... */
+    size_t *rowptr;      /* rows + 1 */
+    int32_t *col;        /* 32-bit global columns (mf_csr) */
+    double *val;
+    /* ... or, when not NULL, global_col[j]: the copies [n_owned, n) of other
+     * ranks' particles hold their owners' global columns (col_of of a copy
+     * only says whether it has one, >= 0). */
+    const long *global_col;
+} mf_rows;
+
+/* Does the pair take part (NULL: every pair of the view does)? */
+typedef bool (*mf_pair_test)(const void *ctx, const mf_pair *pr);
+/* The pair's coefficient a_ij: the row gets -a_ij in j's column, a_ij on
+ * the diagonal. */
+typedef double (*mf_pair_coef)(const void *ctx, const mf_pair *pr);
+/* A neighbour without a column: its known value times a_ij goes to the
+ * right-hand side (acc). */
+typedef void (*mf_pair_known)(void *acc, const void *ctx, const mf_pair *pr, double a);
+
+/* Entries of the row of particle i: 1 (the diagonal) and one per taking
+ * part neighbour with a column. */
+MF_ENGINE size_t mf_pairs_row_count(const mf_pairs *v, size_t i, const uint8_t *jmask,
+                                    mf_pair_test test, const void *ctx, const long *col_of)
+{
+    /* A local copy: its fields stay in registers across the kernel's calls. */
+    const mf_pairs w = *v;
+    const double *pos = w.pos;
+    const double xi = pos[3 * i], yi = pos[3 * i + 1], zi = pos[3 * i + 2];
+    size_t count = 1;
+    mf_pair pr;
+    pr.i = i;
+    for (uint32_t k = w.start[i], end = w.start[i + 1]; k < end; k++) {
+        const size_t j = w.j[k];
+        if ((jmask && !jmask[j]) || col_of[j] < 0)
+            continue;
+        /* Without a test the square root is not needed (the compiler drops
+         * it with the unused pair, but not the errno check of a NaN). */
+        if (!test) {
+            const double *xj = pos + 3 * j;
+            const double dx = xj[0] - xi, dy = xj[1] - yi, dz = xj[2] - zi;
+            count += dx * dx + dy * dy + dz * dz < w.r2;
+        } else if (mf_pairs_entry(&w, k, xi, yi, zi, &pr) && test(ctx, &pr)) {
+            count++;
+        }
+    }
+    return count;
+}
+
+/* Writes the row of particle i at rows->rowptr[row]: the diagonal's column
+ * first (its value is the caller's: returned is the sum of a_ij over the
+ * taking part pairs, known ones included), then -a_ij for each neighbour
+ * with a column, in the view's order; known(acc, ...) for the others. */
+MF_ENGINE double mf_pairs_row_assemble(const mf_pairs *v, size_t i, const uint8_t *jmask,
+                                       mf_pair_test test, mf_pair_coef coef,
+                                       mf_pair_known known, const void *ctx, void *acc,
+                                       const mf_rows *rows, size_t row)
+{
+    const mf_pairs w = *v;
+    const double *pos = w.pos;
+    const long *col_of = rows->col_of;
+    int32_t *col = rows->col;
+    double *val = rows->val;
+    const int64_t offset = rows->col_offset;
+    const double xi = pos[3 * i], yi = pos[3 * i + 1], zi = pos[3 * i + 2];
+    const long *global = rows->global_col;
+    size_t at = rows->rowptr[row];
+    col[at++] = (int32_t)(global ? global[i] : offset + col_of[i]);
+    double sum = 0.0;
+    mf_pair pr;
+    pr.i = i;
+    for (uint32_t k = w.start[i], end = w.start[i + 1]; k < end; k++) {
+        const size_t j = w.j[k];
+        if (jmask && !jmask[j])
+            continue;
+        if (!mf_pairs_entry(&w, k, xi, yi, zi, &pr) || (test && !test(ctx, &pr)))
+            continue;
+        const double a = coef(ctx, &pr);
+        sum += a;
+        const long c = col_of[j];
+        if (c >= 0) {
+            col[at] = (int32_t)(global ? global[j] : offset + c);
+            val[at++] = -a;
+        } else if (known) {
+            known(acc, ctx, &pr, a);
+        }
+    }
+    return sum;
+}
+
+/* The entries of the row of particle i (mf_pairs_row_count with the
+ * assembly's kernels), and the writing of its row r (of the particle i with
+ * col_of[i] == r; mf_pairs_row_assemble, then the diagonal and the
+ * right-hand side). A row function returns false to report the row as
+ * failed: the assembly goes on, and the smallest failed particle is
+ * reported. Both are called through the pointer once a row; the kernels
+ * inside them are inlined. */
+typedef size_t (*mf_count_row_fn)(const void *ctx, size_t i);
+typedef bool (*mf_assemble_row_fn)(const void *ctx, size_t i, size_t row);
+/* Called between the passes with the entry count: sizes the column and
+ * value arrays; nonzero stops the assembly. */
+typedef int (*mf_assemble_sized_fn)(void *ctx, size_t nnz);
+
+/* The matrix of the owned particles i with col_of[i] >= 0 (their rows in
+ * particle order: col_of[i] = 0, 1, ... over them): a parallel count pass
+ * fills rowptr, then sized(), then a parallel pass writes the rows. Returns
+ * in *failed the first failed particle, or SIZE_MAX. */
+MF_ENGINE int mf_pairs_assemble(const mf_pairs *v, const long *col_of, size_t *rowptr,
+                                size_t nrows, mf_count_row_fn count, mf_assemble_sized_fn sized,
+                                mf_assemble_row_fn row, void *ctx, size_t *failed)
+{
+    const long n = (long)v->ni;
+#pragma omp parallel for schedule(static)
+    for (long i = 0; i < n; i++) {
+        const long r = col_of[i];
+        if (r >= 0)
+            rowptr[r + 1] = count(ctx, (size_t)i);
+    }
+    rowptr[0] = 0;
+    for (size_t r = 0; r < nrows; r++)
+        rowptr[r + 1] += rowptr[r];
+    int rc = sized(ctx, rowptr[nrows]);
+    if (rc != 0)
+        return rc;
+    size_t first = SIZE_MAX;
+#pragma omp parallel for schedule(static) reduction(min : first)
+    for (long i = 0; i < n; i++) {
+        const long r = col_of[i];
+        if (r >= 0 && !row(ctx, (size_t)i, (size_t)r) && (size_t)i < first)
+            first = (size_t)i;
+    }
+    *failed = first;
+    return 0;
+}
+
+/* ---- point queries ------------------------------------------------------ */
+
+/* Visits particle j (position xj in cell order, its squared distance d2
+ * from the point: (x^2 + y^2) + z^2 of xj - x); returns false to stop. */
+typedef bool (*mf_point_kernel)(void *acc, const void *ctx, size_t j, const double r[3],
+                                double d2);
+
+/* Every particle of the cells within one cell of x's (the 3^dim block
+ * around it), cells in key order, particles in cell order: every particle
+ * closer to x than the grid's cell size, and some farther ones (the kernel
+ * tests the distance it needs). Nothing when x is more than a cell outside
+ * the grid's box. r = x_j - x from the grid's copy of the positions. */
+MF_ENGINE void mf_grid_near(const mf_grid *g, const double x[3], mf_point_kernel kernel,
+                            const void *ctx, void *acc)
+{
+    if (g->ncells == 0)
+        return;
+    const double w = g->cell_size * (1.0 + MF_GRID_CELL_SLACK);
+    long lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    for (int a = 0; a < g->dim; a++) {
+        double u = floor((x[a] - g->origin[a]) / w);
+        if (!(u + 1 >= 0) || !(u - 1 < (double)g->nbox[a]))
+            return; /* more than a cell outside the box, or NaN */
+        long c = (long)u;
+        lo[a] = c - 1 < 0 ? 0 : c - 1;
+        hi[a] = c + 1 >= (long)g->nbox[a] ? (long)g->nbox[a] - 1 : c + 1;
+    }
+    const size_t np = g->np;
+    const double *sx = g->spos, *sy = g->spos + np, *sz = g->spos + 2 * np;
+    for (long iz = lo[2]; iz <= hi[2]; iz++)
+        for (long iy = lo[1]; iy <= hi[1]; iy++)
+            for (long ix = lo[0]; ix <= hi[0]; ix++) {
+                long c = mf_grid_find_cell(g, mf_grid_key((uint64_t)ix, (uint64_t)iy,
+                                                          (uint64_t)iz));
+                if (c < 0)
+                    continue;
+                for (uint32_t m = g->cell_start[c]; m < g->cell_start[c + 1]; m++) {
+                    const double r[3] = {sx[m] - x[0], sy[m] - x[1], sz[m] - x[2]};
+                    const double d2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+                    if (!kernel(acc, ctx, g->order[m], r, d2))
+                        return;
+                }
+            }
+}
+
+#endif
