@@ -596,10 +596,54 @@ static void test_include(void)
           contains(mf_error_message(), "No such file"));
     printf("  expected error: %s\n", mf_error_message());
     mf_error_clear();
-    CHECK(mf_dict_parse_file(tmp_dir, &d) < 0 && contains(mf_error_message(), "Is a directory"));
+    CHECK(mf_dict_parse_file(tmp_dir, &d) < 0 && contains(mf_error_message(), "is a folder"));
     CHECK(d == NULL);
     printf("  expected error: %s\n", mf_error_message());
     mf_error_clear();
+}
+
+/* Only regular files are read: a FIFO (no writer: reading it would block
+ * forever) and /dev/zero (endless) are refused at once, before a byte is
+ * read, as dictionaries and as includes. */
+static void test_not_regular(void)
+{
+    char fifo[600];
+    snprintf(fifo, sizeof fifo, "%s/fifo", tmp_dir);
+    CHECK(mkfifo(fifo, 0600) == 0);
+    mf_dict *d = NULL;
+    mf_error_clear();
+    CHECK(mf_dict_parse_file(fifo, &d) == MF_ERR_INPUT);
+    CHECK(contains(mf_error_message(), "a FIFO (named pipe), not a regular file"));
+    printf("  expected error: %s\n", mf_error_message());
+    mf_error_clear();
+    const char *p = write_tmp_str("inc_fifo.dict", "a 1;\n#include \"fifo\"\n");
+    CHECK_FAILS_WITH(mf_dict_parse_file(p, &d), "inc_fifo.dict:2:1", "is a FIFO");
+    p = write_tmp_str("inc_zero.dict", "a 1;\n#include \"/dev/zero\"\n");
+    CHECK_FAILS_WITH(mf_dict_parse_file(p, &d), "inc_zero.dict:2:1",
+                     "is a character device, not a regular file");
+    CHECK(d == NULL);
+    CHECK(mf_dict_parse_file("/dev/zero", &d) == MF_ERR_INPUT && d == NULL);
+    mf_error_clear();
+    unlink(fifo);
+}
+
+/* A stray UTF-8 byte order mark: the parser drops one at the start of a
+ * file; a second one is part of the first key, and the writer must keep it
+ * there (not write it where the parser would drop it). */
+static void test_stray_bom(void)
+{
+    static const char text[] = "\xEF\xBB\xBF\xEF\xBB\xBFkey 1;\nw \xEF\xBB\xBFword;\n";
+    mf_dict *d = NULL;
+    CHECK_OK(mf_dict_parse_string(text, sizeof text - 1, "bom", &d));
+    if (!d)
+        return;
+    CHECK(d->n == 2 && strcmp(d->entries[0]->key, "\xEF\xBB\xBFkey") == 0);
+    char *written = NULL;
+    mf_dict *back = round_trip(d, &written);
+    CHECK_MSG(back && dict_equal(d, back), "stray BOM lost in the round trip:\n%s", written);
+    free(written);
+    mf_dict_free(back);
+    mf_dict_free(d);
 }
 
 /* ------------------------------------------------------------------------
@@ -885,6 +929,9 @@ int main(int argc, char **argv)
     test_did_you_mean();
     printf("#include\n");
     test_include();
+    printf("files that are not regular files; a stray byte order mark\n");
+    test_not_regular();
+    test_stray_bom();
     printf("malformed corpus (%s)\n", argv[1]);
     test_corpus(argv[1]);
     printf("malformed input made at run time\n");

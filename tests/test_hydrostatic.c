@@ -1,8 +1,8 @@
 /* test_hydrostatic.c: a 2-D water column at rest in a tank open at the top.
  *
  * After it settles, the time-averaged pressure of interior fluid particles
- * must follow rho g (H - y). Also: no particle is lost, none leaves the
- * tank, and `mpsflow validate` with the hydrostaticPressure metric reports
+ * must follow rho g (H - y). Also: no particle is lost, none passes the
+ * walls, and `mpsflow validate` with the hydrostaticPressure metric reports
  * and writes its files.
  *
  * The resting column is not still: its pressure jitters from step to step
@@ -83,18 +83,24 @@ static void scan_snapshot(const mf_particles *p, const mf_hdf5_header *h, int in
     CHECK_MSG(nfluid == nfluid0, "snapshot %d (t = %g): %zu fluid particles, %zu at the start",
               index, h->time, nfluid, nfluid0);
     CHECK(h->npart[MF_FLUID] == (int64_t)nfluid);
-    /* (b) none outside the tank's inner region. */
+    /* (b) none through a wall: past the wall-particle line, l0/2 outside the
+     * box the fluid fills (the watch's throughWall line). The fluid's own
+     * edge is no bound: a surface particle at a wall jitters a few hundredths
+     * of l0 past it now and then, depending on where within its tolerance
+     * each pressure solve lands (main's code crossed it with tolerance 1e-9
+     * or strongThreshold 0.3, not with the settings here). */
     for (size_t i = 0; i < p->n; i++) {
         if (p->kind[i] != MF_FLUID)
             continue;
         const double *x = &p->pos[3 * i];
         bool finite = isfinite(x[0]) && isfinite(x[1]) && isfinite(p->vel[3 * i]) &&
                       isfinite(p->vel[3 * i + 1]) && isfinite(pr[i]);
-        if (!finite || x[0] < 0 || x[0] > WIDTH || x[1] < 0) {
+        const double h0 = 0.5 * L0;
+        if (!finite || x[0] < -h0 || x[0] > WIDTH + h0 || x[1] < -h0) {
             if (s->outside < 10)
                 fprintf(stderr, "snapshot %d (t = %g): fluid particle id %lld at (%.6g, %.6g) "
-                                "is outside the tank [0, %g] x [0, inf)%s\n",
-                        index, h->time, (long long)p->id[i], x[0], x[1], WIDTH,
+                                "is past the walls [%g, %g] x [%g, inf)%s\n",
+                        index, h->time, (long long)p->id[i], x[0], x[1], -h0, WIDTH + h0, -h0,
                         finite ? "" : " or not finite");
             s->outside++;
         }
@@ -282,7 +288,7 @@ int main(int argc, char **argv)
            "(t >= %g s); number density radius %g l0\n",
            snaps.n, last_time, nfluid0, s ? s->settled : 0, SETTLE, re);
     CHECK_MSG(last_time >= END_TIME * (1 - 1e-9), "the run stopped at t = %g", last_time);
-    CHECK_MSG(s && s->outside == 0, "%ld fluid particle positions outside the tank",
+    CHECK_MSG(s && s->outside == 0, "%ld fluid particle positions past the walls",
               s ? s->outside : -1);
     CHECK(s && s->settled >= 10);
     if (!s || s->settled == 0) {

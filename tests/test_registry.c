@@ -1,7 +1,13 @@
-/* test_registry.c: the module registry and plugin loading.
- * argv[1]: the folder holding libkineticEnergy.so (the build's plugins/). */
+/* test_registry.c: the module registry and plugin loading; a module table
+ * of an older ABI version (read only as far as it goes, its missing slots
+ * NULL). argv[1]: the folder holding libkineticEnergy.so (the build's
+ * plugins/). */
+#include <math.h>
 #include <string.h>
+#include <sys/mman.h>
+#include <unistd.h>
 
+#include "mf_dictio.h"
 #include "mf_hdf5.h"
 #include "mf_modules.h"
 #include "mf_solvers.h"
@@ -66,7 +72,8 @@ static void test_refusals(void)
     CHECK_OK(mf_registry_create(&reg));
     mf_force_ops ok = make_force("good", MF_ABI_VERSION, 1);
     mf_force_ops dup = make_force("good", MF_ABI_VERSION, 1);
-    mf_force_ops old = make_force("old", MF_ABI_VERSION + 1, 1);
+    mf_force_ops newer = make_force("newer", MF_ABI_VERSION + 1, 1);
+    mf_force_ops ancient = make_force("ancient", MF_ABI_OLDEST - 1, 1);
     mf_force_ops noname = make_force("", MF_ABI_VERSION, 1);
     mf_force_ops badcount = make_force("miscounted", MF_ABI_VERSION, 2);
     mf_force_ops badkind = make_force("weird", MF_ABI_VERSION, 1);
@@ -74,9 +81,11 @@ static void test_refusals(void)
     CHECK_OK(mf_registry_add(reg, &ok.info));
     CHECK(mf_registry_add(reg, &dup.info) == MF_ERR_INPUT);
     mf_error_clear();
-    CHECK(mf_registry_add(reg, &old.info) == MF_ERR_INPUT);
+    CHECK(mf_registry_add(reg, &newer.info) == MF_ERR_INPUT);
     printf("ABI mismatch: %s\n", mf_error_message());
     CHECK(strstr(mf_error_message(), "ABI") != NULL);
+    mf_error_clear();
+    CHECK(mf_registry_add(reg, &ancient.info) == MF_ERR_INPUT);
     mf_error_clear();
     CHECK(mf_registry_add(reg, &noname.info) == MF_ERR_INPUT);
     mf_error_clear();
@@ -111,6 +120,109 @@ static void test_plugin(const char *plugin_dir)
     mf_registry_destroy(reg);
 }
 
+/* ---- a force built for ABI version 1 ------------------------------------- */
+/* The layout of mf_force_ops in version 1: the header and three slots. */
+typedef struct force_ops_v1 {
+    mf_module_info info;
+    int (*create)(const void *settings, mf_sim *sim, void **data);
+    int (*accumulate)(void *data, const mf_sim *sim, double *acc);
+    void (*destroy)(void *data);
+} force_ops_v1;
+
+static int v1_create(const void *settings, mf_sim *sim, void **data)
+{
+    (void)sim;
+    *data = (void *)settings;
+    return 0;
+}
+
+static int v1_accumulate(void *data, const mf_sim *sim, double *acc)
+{
+    const dummy_settings *s = data;
+    for (size_t i = 0; i < sim->p->n_owned; i++)
+        acc[3 * i] += s->x;
+    return 0;
+}
+
+static void v1_destroy(void *data) { (void)data; }
+
+/* The v1 table ends exactly where an inaccessible page begins: a host that
+ * read a slot past it (flags, stable_dt, ...) would fault. Registered,
+ * created and called through the wrappers, it must work as a version-1
+ * force does: its acceleration added, no stable step, no surface pressure. */
+static void test_older_abi(void)
+{
+    CHECK(mf_ops_size(MF_KIND_FORCE, 1) == sizeof(force_ops_v1));
+    CHECK(mf_ops_size(MF_KIND_FORCE, MF_ABI_VERSION) == sizeof(mf_force_ops));
+    CHECK(mf_ops_size(MF_KIND_FORCE, MF_ABI_VERSION + 1) == 0);
+    const size_t page = (size_t)sysconf(_SC_PAGESIZE);
+    char *mem = mmap(NULL, 2 * page, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    CHECK(mem != MAP_FAILED);
+    if (mem == MAP_FAILED)
+        return;
+    force_ops_v1 *v1 = (force_ops_v1 *)(mem + page - sizeof *v1);
+    *v1 = (force_ops_v1){
+        .info = {1, MF_KIND_FORCE, "oldForce", "a force built for ABI version 1", dummy_params,
+                 1, sizeof(dummy_settings)},
+        .create = v1_create,
+        .accumulate = v1_accumulate,
+        .destroy = v1_destroy,
+    };
+    CHECK(mprotect(mem + page, page, PROT_NONE) == 0);
+
+    mf_registry *reg = NULL;
+    CHECK_OK(mf_registry_create(&reg));
+    CHECK_OK(mf_registry_add(reg, &v1->info));
+    const mf_module_info *info = NULL;
+    CHECK_OK(mf_registry_find(reg, MF_KIND_FORCE, "oldForce", &info));
+    const mf_force_ops *ops = (const mf_force_ops *)info;
+    CHECK(info && info->abi_version == 1);
+    CHECK(ops && ops->create == v1_create && ops->accumulate == v1_accumulate &&
+          ops->destroy == v1_destroy);
+    CHECK(ops && ops->flags == 0 && !ops->stable_dt && !ops->write_fields &&
+          !ops->claim_surface_pressure && !ops->surface_pressure);
+
+    /* A run's forces: this one alone, on two fluid particles. */
+    mf_log log;
+    mf_log_init(&log, stdout, MF_LOG_QUIET);
+    mf_sim sim;
+    memset(&sim, 0, sizeof sim);
+    sim.dim = 2;
+    sim.l0 = 0.01;
+    sim.nfluids = 1;
+    sim.fluid[0].rho = 1000;
+    sim.log = &log;
+    sim.reg = reg;
+    CHECK_OK(mf_particles_create(2, 4, &sim.p));
+    const double x0[3] = {0, 0, 0}, x1[3] = {0.01, 0, 0}, v[3] = {0, 1, 0};
+    CHECK_OK(mf_particles_add(sim.p, MF_FLUID, x0, v, NULL));
+    CHECK_OK(mf_particles_add(sim.p, MF_FLUID, x1, v, NULL));
+    mf_module m;
+    mf_dict *d = NULL;
+    CHECK_OK(mf_dict_parse_string("x 0.5;", 6, "test", &d));
+    CHECK_OK(mf_module_prepare(reg, MF_KIND_FORCE, "oldForce", d, NULL, NULL, &m));
+    CHECK_OK(ops->create(m.settings, &sim, &m.data));
+    sim.forces = &m;
+    sim.nforces = 1;
+    double acc[6] = {0}, dt = 0;
+    const char *who = "";
+    CHECK_OK(mf_force_accumulate(&sim, acc));
+    CHECK(acc[0] == 0.5 && acc[3] == 0.5 && acc[1] == 0 && sim.forces_record.valid);
+    CHECK_OK(mf_forces_stable_dt(&sim, &dt, &who));
+    CHECK(isinf(dt) && who == NULL);
+    CHECK(!mf_forces_claim_surface_pressure(&sim));
+    double p[2] = {1, 1};
+    const uint8_t dirichlet[2] = {1, 1};
+    CHECK_OK(mf_forces_surface_pressure(&sim, dirichlet, p));
+    CHECK(p[0] == 0 && p[1] == 0);
+    ops->destroy(m.data);
+    mf_module_release(&m);
+    mf_dict_free(d);
+    mf_particles_destroy(sim.p);
+    mf_registry_destroy(reg);
+    munmap(mem, 2 * page);
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -119,6 +231,7 @@ int main(int argc, char **argv)
     }
     test_builtins_and_lookup();
     test_refusals();
+    test_older_abi();
     test_plugin(argv[1]);
     return mf_test_summary("registry");
 }

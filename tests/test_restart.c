@@ -192,6 +192,9 @@ static bool split_run(tc_case *c, const char *exe, const char *tag, const char *
     return true;
 }
 
+/* The end time the final snapshots must show. */
+static double expected_end = END_TIME;
+
 /* Compare the final snapshots of two runs; true if bit-identical. */
 static bool same_end(const tc_case *x, const tc_case *y, const char *label)
 {
@@ -204,7 +207,7 @@ static bool same_end(const tc_case *x, const tc_case *y, const char *label)
         printf("restart %s: one run ends at t = %.17g (step %ld), the restarted one at t = %.17g "
                "(step %ld)\n",
                label, ha.time, ha.step, hb.time, hb.step);
-        CHECK_NEAR(ha.time, END_TIME, 1e-9);
+        CHECK_NEAR(ha.time, expected_end, 1e-9);
         int differing = compare(a.p, b.p, label);
         same = differing == 0 && ha.time == hb.time && ha.step == hb.step;
     } else {
@@ -292,6 +295,89 @@ static void run_pair(const char *exe, const char *label, const char *control,
     tc_case_destroy(&split);
 }
 
+/* From any snapshot: a straight adjustable-dt run to 0.03 s writing every
+ * 0.002 s, then restarts from its snapshots at 0.012, 0.018 and 0.024 s (the
+ * output folder holding those up to it) and one stopped by -endTime 0.018 and
+ * restarted: every one must end bit-identical to the straight run, header
+ * included (write times are k x 0.002, not sums of 0.002, and an endTime
+ * that is a write time ends on it: issue 16). */
+static const char *const control_often =
+    "endTime 0.03;\nadjustTimeStep yes;\ndeltaT 1e-4;\nmaxCo 0.2;\nmaxDeltaT 1e-3;\n"
+    "writeControl adjustableRunTime;\nwriteInterval 0.002;\n";
+
+static bool same_header(const tc_case *x, const tc_case *y, const char *label)
+{
+    tc_snapshots sx, sy;
+    bool same = false;
+    if (tc_snapshots_list(x->dir, &sx) == 0 && tc_snapshots_list(y->dir, &sy) == 0 && sx.n &&
+        sy.n) {
+        char px[800], py[800];
+        tc_snapshot_path(x->dir, sx.index[sx.n - 1], px, sizeof px);
+        tc_snapshot_path(y->dir, sy.index[sy.n - 1], py, sizeof py);
+        mf_hdf5_header a, b;
+        if (mf_hdf5_read_header(px, &a) == 0 && mf_hdf5_read_header(py, &b) == 0)
+            same = a.time == b.time && a.step == b.step && a.dt == b.dt &&
+                   a.dt_natural == b.dt_natural && a.next_id == b.next_id;
+        if (!same)
+            printf("restart %s: headers differ (Time %.17g/%.17g, TimeStep %.17g/%.17g, "
+                   "NaturalTimeStep %.17g/%.17g)\n",
+                   label, a.time, b.time, a.dt, b.dt, a.dt_natural, b.dt_natural);
+    }
+    tc_snapshots_free(&sx);
+    tc_snapshots_free(&sy);
+    return same;
+}
+
+static void restart_from_any(const char *exe)
+{
+    expected_end = 0.03;
+    tc_case whole;
+    if (tc_case_from_strings(&whole, exe, "restart-often", control_often, solver, fluids,
+                             geometry) != 0) {
+        CHECK(!"case created");
+        return;
+    }
+    int status = tc_case_run(&whole, NULL, NULL);
+    CHECK_MSG(status == 0, "the straight run exited with %d", status);
+    static const int from[] = {6, 9, 12}; /* snapshot k is at t = 0.002 k */
+    for (size_t k = 0; status == 0 && k < sizeof from / sizeof from[0]; k++) {
+        tc_case again;
+        char label[64], cmd[2000];
+        snprintf(label, sizeof label, "from snapshot %d (t = %g)", from[k], 0.002 * from[k]);
+        if (tc_case_from_strings(&again, exe, "restart-from", control_often, solver, fluids,
+                                 geometry) != 0) {
+            CHECK(!"case created");
+            continue;
+        }
+        snprintf(cmd, sizeof cmd, "mkdir -p '%s/output' && for i in $(seq 0 %d); do cp \"%s/output/"
+                 "$(printf snapshot_%%06d.h5 $i)\" '%s/output/'; done", again.dir, from[k],
+                 whole.dir, again.dir);
+        CHECK_MSG(system(cmd) == 0, "%s: snapshots copied", label);
+        int s = tc_case_run(&again, NULL, (const char *const[]){"-latestTime", NULL});
+        CHECK_MSG(s == 0, "%s: exit status %d", label, s);
+        bool same = s == 0 && same_end(&whole, &again, label) && same_header(&whole, &again, label);
+        printf("restart %s: %s\n", label, same ? "bit-identical" : "DIFFERENT");
+        CHECK_MSG(same, "restart %s is not bit-identical to the straight run", label);
+        tc_case_destroy(&again);
+    }
+    /* Stopped by -endTime at a write time, then restarted. */
+    tc_case split;
+    if (status == 0 &&
+        tc_case_from_strings(&split, exe, "restart-stop", control_often, solver, fluids,
+                             geometry) == 0) {
+        int s1 = tc_case_run(&split, NULL, (const char *const[]){"-endTime", "0.018", NULL});
+        int s2 = s1 == 0 ? tc_case_run(&split, NULL, (const char *const[]){"-latestTime", NULL})
+                         : -1;
+        CHECK_MSG(s1 == 0 && s2 == 0, "stop at 0.018: exit statuses %d, %d", s1, s2);
+        bool same = s2 == 0 && same_end(&whole, &split, "stopped at 0.018") &&
+                    same_header(&whole, &split, "stopped at 0.018");
+        printf("restart stopped at 0.018 by -endTime: %s\n", same ? "bit-identical" : "DIFFERENT");
+        CHECK_MSG(same, "a run stopped at 0.018 and restarted is not bit-identical");
+        tc_case_destroy(&split);
+    }
+    tc_case_destroy(&whole);
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -300,5 +386,6 @@ int main(int argc, char **argv)
     }
     run_pair(argv[1], "fixed dt", control_fixed, NULL);
     run_pair(argv[1], "adjustable dt", control_adaptive, control_adaptive_seeded);
+    restart_from_any(argv[1]);
     return mf_test_summary("restart");
 }

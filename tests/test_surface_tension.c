@@ -102,6 +102,8 @@ static double *accumulate(world *w, const char *name, const char *dict_text, mf_
     CHECK_OK(ops->create(m->settings, &w->sim, &m->data));
     double *acc = calloc(3 * w->sim.p->n, sizeof *acc);
     CHECK_OK(ops->accumulate(m->data, &w->sim, acc));
+    if (ops->write_fields) /* Curvature, for laplace_jump */
+        CHECK_OK(ops->write_fields(m->data, &w->sim));
     mf_dict_free(d);
     return acc;
 }
@@ -321,7 +323,7 @@ static void check_surface_pressure(double R_l0)
         dirichlet[i] = hypot(x[0], x[1]) > R - 2 * L0;
         amax = fmax(amax, fabs(acc[3 * i]) + fabs(acc[3 * i + 1]));
     }
-    mf_forces_surface_pressure(&w.sim, dirichlet, pd);
+    CHECK_OK(mf_forces_surface_pressure(&w.sim, dirichlet, pd));
     bool zero_elsewhere = true;
     for (size_t i = 0; i < n; i++) {
         if (dirichlet[i]) {

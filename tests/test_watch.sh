@@ -42,6 +42,12 @@ PY
 
 fresh; add_force "nanAt 0.02;"
 trip "NaN injected" nonFinite -endTime 0.1
+grep -q "force 'fault' gave" "$dir/log" || fail "NaN injected: the force is not named"
+
+# A linear solve that returns a NaN: mf_pressure_solve's check names it.
+fresh; add_force "solveNanAt 0.02;"
+trip "NaN from the pressure solve" nonFinite -endTime 0.1
+grep -q "PCG_BoomerAMG returned a non-finite p" "$dir/log" || fail "NaN from the solve: the solve is not named"
 
 fresh; add_force "pushAt 0.02; push (0 -1e7 0);"
 printf 'watch { energyTolerance 1e6; }\n' >> "$dir/case/system/controlDict"
@@ -79,6 +85,13 @@ trip "pressure solve not converging" pressureSolve -endTime 0.1
 fresh
 "$mpsflow" -case "$dir/case" -quiet -endTime 0.3 > "$dir/log" 2>&1 && grep -q "^status *completed;" "$dir/case/output/runSummary" &&
     { echo "ok   stable run: completed with the watch on"; passed=$((passed + 1)); } || fail "stable run did not complete"
+# The watch makes no force pass of its own: one call of each force per attempt.
+steps=$(sed -n 's/^Steps \([0-9]*\) (retried \([0-9]*\)).*/\1 \2/p' "$dir/log")
+calls=$(sed -n 's/^Force gravity: \([0-9]*\) calls.*/\1/p' "$dir/log")
+set -- $steps
+[ -n "$calls" ] && [ "$calls" -eq $(($1 + $2)) ] &&
+    { echo "ok   one force pass a step: gravity ran $calls times in $1 steps ($2 retried)"; passed=$((passed + 1)); } ||
+    fail "force passes: gravity ran '$calls' times in '$steps' steps (retried)"
 
 echo "$passed passed, $failed failed"
 [ $failed -eq 0 ]

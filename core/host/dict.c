@@ -901,6 +901,11 @@ static int write_entries(const mf_dict *d, FILE *f, int level)
     for (size_t k = 0; k < d->n; k++) {
         const mf_entry *e = d->entries[k];
         put_indent(f, level);
+        /* The parser drops a UTF-8 byte order mark at the very start of a
+         * file; a key that begins with one (a stray mark inside the file)
+         * must not be written there, or it would read back without it. */
+        if (level == 0 && strncmp(e->key, "\xEF\xBB\xBF", 3) == 0)
+            fputc(' ', f);
         fputs(e->key, f);
         if (e->n == 1 && e->items[0]->kind == MF_VAL_DICT && e->items[0]->dict) {
             fputc('\n', f);

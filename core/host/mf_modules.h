@@ -1,7 +1,16 @@
 /* mf_modules.h: the kind-specific ops tables. Each starts with the common
  * mf_module_info header (so the registry can hold any of them), then the
  * slots of its kind. Required slots are listed first; optional ones may be
- * NULL. Tables only grow at the end (MF_ABI_VERSION says which layout).
+ * NULL. Tables only grow at the end (MF_ABI_VERSION says which layout): each
+ * slot added after version 1 is marked with the version that added it, and
+ * mf_ops_size gives a kind's table size at each version, so that the
+ * registry can read an older module's table without reading past its end.
+ *
+ * Calls into a module go through the thin wrappers at the end of this file
+ * (mf_force_accumulate, mf_pressure_solve, mf_solver_step, ...), in the
+ * manner of PETSc's KSPSolve and SQLite's API wrappers: the log line, the
+ * timers, the checks of the result and the fault-injection point are there,
+ * once.
  *
  * Naming (PETSc's habit): a module `foo` of kind `bar` implements
  * foo_create, foo_<verb>, foo_destroy as static functions in
@@ -10,6 +19,7 @@
 #ifndef MF_MODULES_H
 #define MF_MODULES_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "mf_registry.h"
@@ -48,6 +58,18 @@ typedef struct mf_csr {
 } mf_csr;
 #define MF_CSR_MAX_GLOBAL INT32_MAX
 
+/* Names of the rows of a system, for a pressure module that reuses work
+ * (an AMG hierarchy) across solves whose rows change: row r is unknown
+ * slot[r] (MPS: the index of its particle), and two solves with the same
+ * nslots and epoch mean the same unknown by the same slot (the caller
+ * changes epoch when the slots change meaning: particles reordered, added
+ * or removed). */
+typedef struct mf_row_names {
+    const int64_t *slot; /* one per local row, distinct, in [0, nslots) */
+    int64_t nslots;
+    uint64_t epoch;
+} mf_row_names;
+
 typedef struct mf_solve_report {
     int iterations;
     double initial_residual; /* ||b - A x0|| / ||b|| */
@@ -63,6 +85,11 @@ typedef struct mf_pressure_ops {
      * MF_RETRY when not converged within the iteration limit. */
     int (*solve)(void *data, const mf_csr *A, const double *b, double *x, mf_solve_report *rep);
     void (*destroy)(void *data);
+    /* ABI 2, optional: solve with the rows named (see mf_row_names), so that the
+     * module may keep its preconditioner across solves of changing matrices.
+     * Absent: mf_pressure_solve calls solve. */
+    int (*solve_rows)(void *data, const mf_csr *A, const mf_row_names *rows, const double *b,
+                      double *x, mf_solve_report *rep);
 } mf_pressure_ops;
 
 /* ---- convection scheme (MPS-MAFL Eulerian phase) -------------------------- */
@@ -76,12 +103,48 @@ typedef struct mf_convection_ops {
 } mf_convection_ops;
 
 /* ---- force: adds an acceleration to fluid particles ---------------------- */
+/* mf_force_ops.flags */
+enum {
+    /* An interaction among the fluid particles only (no body force, no
+     * wall, no outside medium): on fluid particles alone the momentum it
+     * adds, sum_i m_i a_i, vanishes (in the continuum, and within the
+     * discretisation's error on particles): tests/test_force_conformance.c
+     * checks it. surfaceTension is one; gravity and drag are not. */
+    MF_FORCE_INTERNAL = 1u << 0,
+};
+
 typedef struct mf_force_ops {
     mf_module_info info;
     int (*create)(const void *settings, mf_sim *sim, void **data);
-    /* acc has 3 * sim->p->n entries; add this force's acceleration (m/s^2). */
+    /* Required. Add this force's acceleration (m/s^2) of the owned particles
+     * at their current state to acc (3 * sim->p->n entries). Side-effect
+     * free: it changes nothing in sim (no particle, no field), and two calls
+     * on the same state give the same acc; the module may keep what it
+     * computed in its own data, for write_fields and surface_pressure.
+     * Solvers call it through mf_force_accumulate, never directly. */
     int (*accumulate)(void *data, const mf_sim *sim, double *acc);
     void (*destroy)(void *data);
+    /* ABI 2: MF_FORCE_* flags. */
+    unsigned flags;
+    /* ABI 2, optional: the largest step this force allows at the current
+     * state (INFINITY: none). The time loop takes the smallest of every
+     * force's, the solver's and the case's limits (mf_stable_dt). */
+    int (*stable_dt)(void *data, const mf_sim *sim, double *dt);
+    /* ABI 2, optional: fill the output fields the module requested at create
+     * (surfaceTension: Curvature, SurfaceTension) from its last accumulate;
+     * called by mf_force_accumulate right after it, on the same particles. */
+    int (*write_fields)(void *data, mf_sim *sim);
+    /* ABI 2, optional, for a force that acts on a free surface through its
+     * pressure (surfaceTension's freeSurface pressure: the Laplace pressure
+     * becomes eq. 18's Dirichlet value). claim_surface_pressure: a solver
+     * that holds such pressures calls it once at create (through
+     * mf_forces_claim_surface_pressure); true if this force has one, and
+     * from then on the force leaves the free surface to it (a force that
+     * needs the claim and did not get it fails its accumulate, saying so).
+     * surface_pressure: after this step's accumulate, add the force's
+     * pressure of every owned particle with dirichlet[i] set to p[i]. */
+    bool (*claim_surface_pressure)(void *data);
+    int (*surface_pressure)(void *data, const mf_sim *sim, const uint8_t *dirichlet, double *p);
 } mf_force_ops;
 
 /* ---- function object: observes a run ------------------------------------ */
@@ -104,7 +167,7 @@ typedef struct mf_writer_ops {
     /* Optional: restore particles, time and step from the newest snapshot.
      * Returns MF_ERR_INPUT if there is none. */
     int (*read_latest)(void *data, mf_sim *sim);
-    /* Optional (purgeWrite): delete the snapshots this writer wrote but the
+    /* ABI 2, optional (purgeWrite): delete the snapshots this writer wrote but the
      * newest `keep`; the initial state (snapshot 0) is never deleted. */
     int (*purge)(void *data, long keep);
 } mf_writer_ops;
@@ -124,6 +187,11 @@ typedef struct mf_surface_ops {
     int (*reconstruct)(void *data, const mf_sim *sim, struct mf_mesh *out);
 } mf_surface_ops;
 
+/* The size of a kind's table as a module built for ABI version abi has it
+ * (0: unknown kind or version). Tables only grow, so an older table is the
+ * prefix of the current layout of this size. */
+size_t mf_ops_size(mf_module_kind kind, int abi);
+
 /* ---- creating a module from a case ------------------------------------- */
 /* Find `name` of `kind`, allocate its settings and fill them from dict
  * (defaults for what dict does not give; extra_keys are allowed but not the
@@ -134,5 +202,47 @@ int mf_module_prepare(const mf_registry *reg, mf_module_kind kind, const char *n
                       mf_module *out);
 /* Free the settings (call the kind's destroy on out->data first). */
 void mf_module_release(mf_module *m);
+
+/* ---- calling modules: the thin wrappers (core/host/module_calls.c) ------ */
+/* Every force of the case (sim->forces): add their accelerations of the
+ * owned particles at the current state to acc (3 * sim->p->n entries, not
+ * cleared). Also: each force's write_fields; a check that every
+ * acceleration is finite (MF_ERR_NUMERIC, `unstable (nonFinite)`, naming
+ * the force and the particle); the fault-injection point; the forces' time;
+ * and the record of this step's accelerations that the run's watch reads
+ * instead of a second pass (the ForceAcceleration field, not written to
+ * snapshots, and the power sum m a.u at the state the forces saw). A solver
+ * calls it once per step, in its explicit phase. */
+int mf_force_accumulate(mf_sim *sim, double *acc);
+/* The smallest stable step of the forces (INFINITY: none limits it) and the
+ * name of the force that sets it (NULL: none). */
+int mf_forces_stable_dt(const mf_sim *sim, double *dt, const char **who);
+/* The smallest stable step of the solver and the forces, for the time loop;
+ * *who names the module that sets it (NULL: none limits it). */
+int mf_stable_dt(const mf_module *solver, const mf_sim *sim, double *dt, const char **who);
+/* A solver that holds free-surface pressures claims them (true: some force
+ * has one; see mf_force_ops.claim_surface_pressure), and each step, after
+ * mf_force_accumulate and once the free surface is known, gets p[i] (one
+ * entry per particle: the forces' pressure where dirichlet[i] is set, 0
+ * elsewhere). */
+bool mf_forces_claim_surface_pressure(mf_sim *sim);
+int mf_forces_surface_pressure(const mf_sim *sim, const uint8_t *dirichlet, double *p);
+
+/* One linear solve with pressure module m (a created mf_module of kind
+ * pressure): A x = b, x the initial guess on entry. Prints OpenFOAM's line
+ * `NAME:  Solving for FIELD, Initial residual = r0, Final residual = r, No
+ * Iterations N`, adds the call's time to m->seconds, checks that x came
+ * back finite (MF_ERR_NUMERIC otherwise), passes the fault-injection point.
+ * MF_RETRY (not converged) is returned as the module returned it, with rep
+ * filled, for the caller to name what it was solving. */
+int mf_pressure_solve(mf_module *m, const mf_sim *sim, const char *field, const mf_csr *A,
+                      const double *b, double *x, mf_solve_report *rep);
+/* The same with the rows named (rows may be NULL: as mf_pressure_solve). */
+int mf_pressure_solve_rows(mf_module *m, const mf_sim *sim, const char *field, const mf_csr *A,
+                           const mf_row_names *rows, const double *b, double *x,
+                           mf_solve_report *rep);
+
+/* One step of the solver module: the time, the fault-injection point. */
+int mf_solver_step(mf_module *solver, mf_sim *sim, double dt);
 
 #endif

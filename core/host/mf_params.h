@@ -49,5 +49,20 @@ int mf_params_apply(const mf_param *table, size_t n, const mf_dict *dict,
 int mf_params_defaults(const mf_param *table, size_t n, void *settings);
 /* Print the table for `mpsflow modules NAME`. */
 void mf_params_print(const mf_param *table, size_t n, FILE *f);
+/* The same as a markdown table (docs/reference.md). */
+void mf_params_print_markdown(const mf_param *table, size_t n, FILE *f);
+
+/* One table of a case dictionary that is not a module's: controlDict, the
+ * watch {} block, each element kind of constant/geometry, a fluid of
+ * constant/fluids, a validation metric, compareDict, stabilityDict. `name`
+ * says where the keys go ("geometry: fluidBlocks/<name>, type box"). The
+ * code that reads the dictionary applies the same table (mf_params_apply),
+ * so that what is printed is what is checked. */
+typedef struct mf_param_section {
+    const char *name;
+    const char *summary;
+    const mf_param *params;
+    size_t nparams;
+} mf_param_section;
 
 #endif

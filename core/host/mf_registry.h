@@ -5,6 +5,14 @@
  *  - A module is a const ops table that starts with mf_module_info. The
  *    kind-specific tables (mf_solver_ops, ... in mf_modules.h) only ever
  *    grow at the end; abi_version says which layout a module was built for.
+ *    mf_module_info itself never changes.
+ *  - Older tables are accepted (any version from MF_ABI_OLDEST on): the
+ *    registry knows each kind's table size at each version (mf_ops_size),
+ *    copies the module's table, that many bytes and no more, into a zeroed
+ *    table of the current layout, and hands out the copy, so the slots the
+ *    module's version did not have read as NULL (absent optional slots) and
+ *    nothing past the end of the module's table is ever read. A table newer
+ *    than this host is refused: it may rely on slots the host never calls.
  *  - Names are unique within a kind; a registered table never changes and
  *    must outlive the registry (static storage, or a plugin kept loaded).
  *  - Built-ins register through one explicit call (mf_register_builtins);
@@ -20,7 +28,12 @@
 
 #include "mf_params.h"
 
-#define MF_ABI_VERSION 1
+/* Versions of the tables' layout (mf_modules.h lists what each added):
+ *   1  the first tables;
+ *   2  force: flags, stable_dt, write_fields, claim_surface_pressure,
+ *      surface_pressure; pressure: solve_rows; writer: purge. */
+#define MF_ABI_VERSION 2
+#define MF_ABI_OLDEST 1
 
 typedef enum {
     MF_KIND_SOLVER,
@@ -49,7 +62,9 @@ int mf_registry_create(mf_registry **out);
 void mf_registry_destroy(mf_registry *reg); /* also dlcloses plugins */
 
 /* Add a module. Refuses a NULL/empty name, a duplicate name within its kind,
- * an ABI version it does not know, and a kind out of range. */
+ * an ABI version outside [MF_ABI_OLDEST, MF_ABI_VERSION], and a kind out of
+ * range. The tables that find and at return are of the current layout: the
+ * module's own, or the registry's upgraded copy of an older one. */
 int mf_registry_add(mf_registry *reg, const mf_module_info *module);
 
 /* Find by kind and name. Unknown: MF_ERR_INPUT naming the valid choices. */

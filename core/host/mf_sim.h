@@ -34,6 +34,9 @@ typedef struct mf_module {
     const mf_module_info *info;
     void *settings; /* info->settings_size bytes, filled from the parameter table */
     void *data;     /* the module's own state (from create) */
+    /* Kept by the calling wrappers (mf_modules.h): calls and their seconds. */
+    long calls;
+    double seconds;
 } mf_module;
 
 /* A wall box as the scene built it: the region it encloses and which faces
@@ -42,6 +45,33 @@ typedef struct mf_wall_box {
     double min[3], max[3];
     bool open[3][2];
 } mf_wall_box;
+
+/* ---- fault injection (tests) --------------------------------------------- */
+/* Where the calling wrappers (mf_modules.h) offer a test hook a chance to
+ * break the result. */
+typedef enum {
+    MF_FAULT_FORCE,    /* after a force's accumulate: values = acc, 3 per particle */
+    MF_FAULT_PRESSURE, /* after a linear solve: values = x, one per row */
+    MF_FAULT_STEP,     /* after the solver's step: values = NULL */
+} mf_fault_site;
+/* The hook sees the module's name, its output and its return code, and
+ * returns the code to go on with (it may also change the values). Installed
+ * in sim->fault by a test-only module (tests/plugins/faultInjection.c). */
+struct mf_sim;
+typedef struct mf_fault_hook {
+    int (*fn)(void *ctx, const struct mf_sim *sim, mf_fault_site site, const char *module,
+              double *values, size_t n, int rc);
+    void *ctx;
+} mf_fault_hook;
+
+/* What mf_force_accumulate recorded of the step being taken, for the run's
+ * watch (which uses it instead of a second force pass). */
+#define MF_FORCE_FIELD "ForceAcceleration" /* 3 per particle, not in snapshots */
+typedef struct mf_force_record {
+    bool valid;   /* the forces ran in this attempt (the time loop clears it); their
+                     accelerations are in the particle field MF_FORCE_FIELD */
+    double power; /* sum over fluid particles of m a.u at the state the forces saw */
+} mf_force_record;
 
 typedef struct mf_sim {
     int dim;
@@ -57,10 +87,6 @@ typedef struct mf_sim {
                                   to land on a write time: the controller grows from it, so
                                   a restart needs it to continue exactly */
     long step;
-    /* Time-step control (system/controlDict). */
-    double max_courant;
-    double max_dt;
-    bool fixed_dt;
     /* Modules the case names, in order. */
     size_t nforces;
     mf_module *forces;         /* kind MF_KIND_FORCE */
@@ -86,7 +112,6 @@ typedef struct mf_sim {
      * there are none. */
     mf_halo *halo;
     /* Statistics the driver reports (filled by modules). */
-    double courant_mean, courant_max;
     long pressure_iterations;  /* summed over the run */
     /* Transported scalars ("dye", "temperature"): optional particle fields of
      * these names, declared by the case (mf_emitter.h); a solver that convects
@@ -96,6 +121,25 @@ typedef struct mf_sim {
     /* Inlets, outlets and nozzles (mf_emitter.h), applied by the time loop
      * before each step; NULL when the case has none. */
     struct mf_emitters *emitters;
+    /* Snapshots written so far by this process. A module that keeps work
+     * from step to step (an AMG hierarchy) starts afresh when it changes:
+     * a run restarted from a snapshot then repeats the straight run bit for
+     * bit, both having started afresh at that step. */
+    long snapshot_epoch;
+    /* This step's force accelerations (mf_force_accumulate). */
+    mf_force_record forces_record;
+    /* Tests only: a hook the calling wrappers offer their results to (no
+     * hook: fn NULL). */
+    mf_fault_hook fault;
 } mf_sim;
+
+/* Mass of particle i: rho l0^d of its fluid; fluid_field is the index of
+ * the FluidId field (-1 with one fluid: fluid 0). */
+static inline double mf_sim_particle_mass(const mf_sim *sim, int fluid_field, size_t i)
+{
+    const int f = fluid_field >= 0 ? mf_particles_fi(sim->p, fluid_field)[i] : 0;
+    const double vol = sim->dim == 3 ? sim->l0 * sim->l0 * sim->l0 : sim->l0 * sim->l0;
+    return sim->fluid[f].rho * vol;
+}
 
 #endif

@@ -1,4 +1,5 @@
 /* module.c: create the settings of a module from a dictionary. */
+#include <stddef.h>
 #include <stdlib.h>
 
 #include "mf_error.h"
@@ -32,4 +33,24 @@ void mf_module_release(mf_module *m)
     m->settings = NULL;
     m->info = NULL;
     m->data = NULL;
+}
+
+size_t mf_ops_size(mf_module_kind kind, int abi)
+{
+    if (abi < MF_ABI_OLDEST || abi > MF_ABI_VERSION)
+        return 0;
+    switch (kind) {
+    case MF_KIND_SOLVER: return sizeof(mf_solver_ops);
+    /* ABI 2 added solve_rows. */
+    case MF_KIND_PRESSURE:
+        return abi >= 2 ? sizeof(mf_pressure_ops) : offsetof(mf_pressure_ops, solve_rows);
+    case MF_KIND_CONVECTION: return sizeof(mf_convection_ops);
+    /* ABI 2 added flags and the slots after it. */
+    case MF_KIND_FORCE: return abi >= 2 ? sizeof(mf_force_ops) : offsetof(mf_force_ops, flags);
+    case MF_KIND_FUNCTION_OBJECT: return sizeof(mf_function_object_ops);
+    case MF_KIND_SURFACE: return sizeof(mf_surface_ops);
+    /* ABI 2 added purge. */
+    case MF_KIND_WRITER: return abi >= 2 ? sizeof(mf_writer_ops) : offsetof(mf_writer_ops, purge);
+    default: return 0;
+    }
 }

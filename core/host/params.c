@@ -271,3 +271,39 @@ void mf_params_print(const mf_param *table, size_t n, FILE *f)
                 p->def ? p->def : (p->type == MF_PARAM_DICT ? "{}" : "(required)"), range, p->doc);
     }
 }
+
+/* A table cell: '|' would end the cell. */
+static void put_cell(FILE *f, const char *s)
+{
+    for (; s && *s; s++) {
+        if (*s == '|')
+            fputs("\\|", f);
+        else
+            fputc(*s, f);
+    }
+}
+
+void mf_params_print_markdown(const mf_param *table, size_t n, FILE *f)
+{
+    if (n == 0) {
+        fprintf(f, "(no parameters)\n");
+        return;
+    }
+    fprintf(f, "| key | type | default | range | meaning |\n|---|---|---|---|---|\n");
+    for (size_t i = 0; i < n; i++) {
+        const mf_param *p = &table[i];
+        char range[256] = "";
+        if (has_range(p))
+            snprintf(range, sizeof range, "[%g, %g]", p->min, p->max);
+        else if (p->choices)
+            for (size_t k = 0; p->choices[k]; k++) {
+                strncat(range, k ? " \\| " : "", sizeof range - strlen(range) - 1);
+                strncat(range, p->choices[k], sizeof range - strlen(range) - 1);
+            }
+        fprintf(f, "| `%s` | %s | ", p->name, mf_param_type_name(p->type));
+        put_cell(f, p->def ? p->def : (p->type == MF_PARAM_DICT ? "{}" : "(required)"));
+        fprintf(f, " | %s | ", range[0] ? range : "-");
+        put_cell(f, p->doc);
+        fprintf(f, " |\n");
+    }
+}

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "mf_error.h"
+#include "mf_modules.h" /* mf_ops_size */
 
 #define MF_MAX_PLUGINS 64
 
@@ -17,6 +18,10 @@ struct mf_registry {
     char *plugin_name[MF_MAX_PLUGINS];
     int nplugins;
     char *plugin_dir;
+    /* Tables of older modules copied into the current layout (freed with
+     * the registry). */
+    void **upgraded;
+    size_t nupgraded, cap_upgraded;
 };
 
 static const char *const kind_names[MF_KIND_COUNT] = {
@@ -42,6 +47,9 @@ void mf_registry_destroy(mf_registry *reg)
         return;
     for (int k = 0; k < MF_KIND_COUNT; k++)
         free(reg->mod[k]);
+    for (size_t i = 0; i < reg->nupgraded; i++)
+        free(reg->upgraded[i]);
+    free(reg->upgraded);
     /* Tables of a plugin live in its library: close those last. */
     for (int i = reg->nplugins - 1; i >= 0; i--) {
         dlclose(reg->plugin_handle[i]);
@@ -51,15 +59,42 @@ void mf_registry_destroy(mf_registry *reg)
     free(reg);
 }
 
+/* A table of an older layout: copy its mf_ops_size(kind, its version)
+ * bytes into a zeroed table of the current layout, so the slots added since
+ * read as NULL; nothing past the module's own table is read. */
+static int upgrade_table(mf_registry *reg, const mf_module_info *m, const mf_module_info **out)
+{
+    const size_t old = mf_ops_size(m->kind, m->abi_version);
+    const size_t now = mf_ops_size(m->kind, MF_ABI_VERSION);
+    if (old == 0 || now < old)
+        return MF_ERROR(MF_ERR_INTERNAL, "no table size for a %s module of ABI version %d",
+                        kind_names[m->kind], m->abi_version);
+    if (reg->nupgraded == reg->cap_upgraded) {
+        size_t cap = reg->cap_upgraded ? 2 * reg->cap_upgraded : 8;
+        void **grown = realloc(reg->upgraded, cap * sizeof *grown);
+        if (!grown)
+            return MF_ERROR(MF_ERR_MEMORY, "out of memory registering '%s'", m->name);
+        reg->upgraded = grown;
+        reg->cap_upgraded = cap;
+    }
+    void *copy = calloc(1, now);
+    if (!copy)
+        return MF_ERROR(MF_ERR_MEMORY, "out of memory registering '%s'", m->name);
+    memcpy(copy, m, old);
+    reg->upgraded[reg->nupgraded++] = copy;
+    *out = copy;
+    return 0;
+}
+
 int mf_registry_add(mf_registry *reg, const mf_module_info *m)
 {
     if (!m || !m->name || !m->name[0])
         return MF_ERROR(MF_ERR_INPUT, "refusing to register a module without a name");
-    if (m->abi_version != MF_ABI_VERSION)
+    if (m->abi_version > MF_ABI_VERSION || m->abi_version < MF_ABI_OLDEST)
         return MF_ERROR(MF_ERR_INPUT,
-                        "module '%s' was built for module ABI version %d, this mpsflow has %d: "
-                        "rebuild it against this version's headers",
-                        m->name, m->abi_version, MF_ABI_VERSION);
+                        "module '%s' was built for module ABI version %d, this mpsflow reads "
+                        "versions %d to %d: rebuild it against this version's headers",
+                        m->name, m->abi_version, MF_ABI_OLDEST, MF_ABI_VERSION);
     if (m->kind < 0 || m->kind >= MF_KIND_COUNT)
         return MF_ERROR(MF_ERR_INPUT, "module '%s' has an unknown kind %d", m->name, (int)m->kind);
     if (m->nparams && !m->params)
@@ -84,7 +119,10 @@ int mf_registry_add(mf_registry *reg, const mf_module_info *m)
         reg->mod[k] = grown;
         reg->cap[k] = cap;
     }
-    reg->mod[k][reg->n[k]++] = m;
+    const mf_module_info *table = m;
+    if (m->abi_version < MF_ABI_VERSION)
+        MF_CALL(upgrade_table(reg, m, &table));
+    reg->mod[k][reg->n[k]++] = table;
     return 0;
 }
 

@@ -113,4 +113,15 @@ int mf_particles_append_packed(mf_particles *p, const void *buf, size_t n);
 void mf_particles_count_kinds(const mf_particles *p, size_t counts[MF_NKINDS]);
 size_t mf_particles_memory(const mf_particles *p); /* bytes held */
 
+/* What a run holds per particle, bytes, before it has any: the particle
+ * arrays (with a dozen optional fields) twice (the time loop keeps a copy
+ * to retry a step from), the cell grid, two neighbour lists and a sparse
+ * pressure-matrix row (kept twice: assembly and solver copies) at the
+ * largest radius `radius_l0` (in particle spacings), whose entries are the
+ * lattice points within it, and a snapshot's image (built in memory, then
+ * written: io/hdf5/hdf5_writer.c). A model for refusing a scene before it is
+ * built, not an accounting: docs/incoming/input.md compares it with peak
+ * memory measured on the tutorials. */
+double mf_memory_per_particle(int dim, double radius_l0);
+
 #endif

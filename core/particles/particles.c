@@ -442,3 +442,32 @@ size_t mf_particles_memory(const mf_particles *p)
         bytes += (p->cap ? p->cap : 1) * field_elem_size(&p->field[f]);
     return bytes;
 }
+
+/* Lattice points other than the origin within radius r (in spacings). */
+static long lattice_neighbours(int dim, double r)
+{
+    long m = (long)r + 1, count = 0;
+    for (long i = -m; i <= m; i++)
+        for (long j = -m; j <= m; j++)
+            for (long k = dim == 3 ? -m : 0; k <= (dim == 3 ? m : 0); k++) {
+                double d2 = (double)(i * i + j * j + k * k);
+                count += d2 > 0 && d2 < r * r;
+            }
+    return count;
+}
+
+double mf_memory_per_particle(int dim, double radius_l0)
+{
+    if (!(radius_l0 >= 1) || radius_l0 > 20)
+        radius_l0 = radius_l0 > 20 ? 20 : 1;
+    const double arrays = 3 * sizeof(double) * 2 + sizeof(uint8_t) + sizeof(int64_t) +
+                          12 * sizeof(double);
+    const double grid = sizeof(size_t) + 3 * sizeof(double) + 2 * sizeof(uint64_t) +
+                        2 * sizeof(uint32_t);
+    const double nb = (double)lattice_neighbours(dim == 3 ? 3 : 2, radius_l0);
+    const double lists = 2 * (nb * sizeof(uint32_t) + sizeof(size_t));
+    const double matrix = 2 * (nb + 1) * (sizeof(double) + sizeof(int32_t));
+    /* A snapshot is built in memory before it is written: twice the arrays. */
+    const double snapshot = 2 * arrays;
+    return 2 * arrays + grid + lists + matrix + snapshot;
+}

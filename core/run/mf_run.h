@@ -12,6 +12,7 @@
 
 #include <stdbool.h>
 
+#include "mf_clock.h" /* mf_wall_seconds, mf_cpu_seconds */
 #include "mf_modules.h"
 #include "mf_sim.h"
 #include "mf_watch.h"
@@ -81,9 +82,6 @@ int mf_run_signal_received(void);
 int mf_stop_at_parse(const char *word, mf_stop_at *out);
 const char *mf_stop_at_name(mf_stop_at s);
 
-/* Seconds since an arbitrary origin (monotonic) and process CPU seconds. */
-double mf_wall_seconds(void);
-double mf_cpu_seconds(void);
 /* Peak resident memory of this process, bytes. */
 size_t mf_peak_memory(void);
 

@@ -10,7 +10,9 @@
  *                 fluid has blown apart when it thins from where it was);
  *   energy        kinetic energy growing without a source: KE - KE0 - W,
  *                 W the work of the force modules (gravity, surface tension,
- *                 ...) integrated over the run, above a fraction of the
+ *                 ...) integrated over the run, from the accelerations each
+ *                 step's forces gave (mf_force_accumulate records them: the
+ *                 watch makes no force pass of its own), above a fraction of the
  *                 run's energy scale KE0 + |W| + sum m |a_ext| L + sigma S
  *                 (S: the surface of the fluid's bounding box at the start;
  *                 surface tension applied as a pressure condition does work
@@ -45,12 +47,9 @@ typedef struct mf_watch {
     double ke0;          /* kinetic energy when the watch started */
     double work;         /* work of the force modules since then */
     double pot_scale;    /* sum m |a_ext| L at the start */
-    double power;        /* force power at the last accepted step */
     double n_start;      /* mean fluid number density at the first check (-1: not yet) */
-    double *acc;         /* scratch: force accelerations, 3 per particle */
-    size_t cap;
-    /* Candidate values of the step being checked (committed on accept). */
-    double next_work, next_power;
+    /* Candidate value of the step being checked (committed on accept). */
+    double next_work;
 } mf_watch;
 
 extern const mf_param mf_watch_params[];
@@ -58,7 +57,6 @@ extern const size_t mf_watch_nparams;
 
 /* Settings from controlDict's `watch { ... }` (dict may be NULL: defaults). */
 int mf_watch_init(mf_watch *w, const mf_dict *dict, mf_dict *resolved);
-void mf_watch_free(mf_watch *w);
 /* Check the state after a step of dt. 0, or MF_ERR_NUMERIC with a diagnosis. */
 int mf_watch_check(mf_watch *w, const mf_sim *sim, double dt);
 /* The step was accepted: keep its energy bookkeeping. */

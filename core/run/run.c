@@ -12,20 +12,6 @@
 #include "mf_error.h"
 #include "mf_timestep.h"
 
-double mf_wall_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
-double mf_cpu_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
 size_t mf_peak_memory(void)
 {
     struct rusage ru;
@@ -145,16 +131,47 @@ static int diagnose_collapse(const mf_sim *sim, double dt, double floor_dt, cons
                     sqrt(fmax(u2max, 0)));
 }
 
+/* The time the step must not pass: the next write time (adjustableRunTime)
+ * or the end. A step within a hair of it (relative 1e-9, far above the
+ * rounding of sums of steps) is shortened to end there, and the time is then
+ * set to the target itself, not to time + dt: a fixed step, or one chosen by
+ * the limits, lands exactly on endTime and on every write time. *land is
+ * the target when the step lands on it, NAN otherwise. */
+static void land_on_target(const mf_run *run, double next_write, double *dt, double *land)
+{
+    const mf_sim *sim = run->sim;
+    double target = sim->end_time;
+    /* An end time that is a write time (0.018 and 9 x 0.002 differ in the
+     * last bit) ends on the write time: a run stopped there and restarted
+     * then takes the steps of the run that went on through it. */
+    if (!run->ctl.write_by_steps &&
+        (next_write < target || fabs(next_write - target) <= 1e-9 * target))
+        target = next_write;
+    const double left = target - sim->time;
+    *land = NAN;
+    if (left > 0 && *dt >= left * (1 - 1e-9)) {
+        /* A fixed step that reaches the target but for rounding (k steps of
+         * deltaT to a write time) stays deltaT: only the time is set. */
+        if (run->ctl.adjust || fabs(*dt - left) > 1e-9 * *dt)
+            *dt = left;
+        *land = target;
+    } else if (left > 0 && run->ctl.adjust && *dt > 0.5 * left) {
+        *dt = 0.5 * left; /* two even steps rather than a sliver */
+    }
+}
+
 /* The step the limits allow ("natural"), then shortened to land on the next
  * write time or the end. Growth is limited relative to the last natural
  * step, so a sliver taken to land on a write time does not hold dt down. */
-static int choose_dt(mf_run *run, double next_write, double *dt, const char **limiter)
+static int choose_dt(mf_run *run, double next_write, double *dt, const char **limiter,
+                     double *land)
 {
     mf_sim *sim = run->sim;
     const mf_run_control *c = &run->ctl;
     if (!c->adjust) {
         *dt = c->delta_t;
         *limiter = "fixed";
+        land_on_target(run, next_write, dt, land);
     } else {
         mf_dt_choice ch;
         double umax = mf_max_fluid_speed(sim->p);
@@ -170,26 +187,20 @@ static int choose_dt(mf_run *run, double next_write, double *dt, const char **li
             natural = 1.2 * last;
             *limiter = "growth";
         }
-        if (run->solver_ops->stable_dt) {
-            double sdt = INFINITY;
-            MF_CALL(run->solver_ops->stable_dt(run->solver->data, sim, &sdt));
-            mf_parallel_min(sim->par, &sdt, 1);
-            if (sdt < natural) {
-                natural = sdt;
-                *limiter = "solver";
-            }
+        /* The solver's and every force's own limit (surfaceTension's
+         * capillary step, a plugin's), whatever the solver; the smallest
+         * over the ranks (the name is this rank's). */
+        double sdt = INFINITY;
+        const char *who = NULL;
+        MF_CALL(mf_stable_dt(run->solver, sim, &sdt, &who));
+        mf_parallel_min(sim->par, &sdt, 1);
+        if (sdt < natural) {
+            natural = sdt;
+            *limiter = who ? who : "solver";
         }
         run->sim->dt_natural = natural;
         *dt = natural;
-        /* Land on write times and the end time (adjustableRunTime). */
-        double target = sim->end_time;
-        if (!c->write_by_steps && next_write < target)
-            target = next_write;
-        double left = target - sim->time;
-        if (left > 0 && *dt >= left * (1 - 1e-9))
-            *dt = left;
-        else if (left > 0 && *dt > 0.5 * left)
-            *dt = 0.5 * left; /* two even steps rather than a sliver */
+        land_on_target(run, next_write, dt, land);
     }
     if (!(*dt > 0) || !isfinite(*dt))
         return MF_ERROR(MF_ERR_NUMERIC, "the time step became %g at time %g", *dt, sim->time);
@@ -205,6 +216,7 @@ static int write_now(mf_run *run)
     /* Collective, and rank 0 alone writes the index: agree on the outcome. */
     MF_CALL(mf_parallel_agree(run->sim->par,
                               run->writer_ops->write(run->writer->data, run->sim, run->params)));
+    run->sim->snapshot_epoch++;
     int rc = 0;
     for (size_t k = 0; k < run->nfunctions && rc == 0; k++) {
         const mf_function_object_ops *fo = (const mf_function_object_ops *)run->functions[k].info;
@@ -242,40 +254,42 @@ static int apply_emitters(mf_run *run, double dt, double *kinetic_in, size_t *ad
 
 /* Courant numbers of the fluid over all ranks (the mean weighted by each
  * rank's fluid count). */
-static void courant(mf_sim *sim, double dt)
+static void courant(const mf_sim *sim, double dt, double *mean, double *max)
 {
-    mf_courant(sim->p, dt, sim->l0, &sim->courant_mean, &sim->courant_max);
+    mf_courant(sim->p, dt, sim->l0, mean, max);
     if (!sim->par)
         return;
     size_t counts[MF_NKINDS];
     mf_particles_count_kinds(sim->p, counts);
-    double v[2] = {sim->courant_mean * (double)counts[MF_FLUID], (double)counts[MF_FLUID]};
+    double v[2] = {*mean * (double)counts[MF_FLUID], (double)counts[MF_FLUID]};
     mf_parallel_sum(sim->par, v, 2);
-    sim->courant_mean = v[1] > 0 ? v[0] / v[1] : 0.0;
-    mf_parallel_max(sim->par, &sim->courant_max, 1);
+    *mean = v[1] > 0 ? v[0] / v[1] : 0.0;
+    mf_parallel_max(sim->par, max, 1);
 }
 
 static int step_once(mf_run *run, saved_state *saved, double next_write)
 {
     mf_sim *sim = run->sim;
-    double dt = 0;
+    double dt = 0, land = NAN;
     const char *limiter = NULL;
-    MF_CALL(choose_dt(run, next_write, &dt, &limiter));
+    MF_CALL(choose_dt(run, next_write, &dt, &limiter, &land));
     MF_CALL(save_state(saved, sim->p, sim->time));
     const double work0 = run->watch.work;
     size_t added = 0, removed = 0;
     for (long attempt = 0;; attempt++) {
         sim->dt = dt;
-        courant(sim, dt);
-        mf_log_printf(sim->log, MF_LOG_STEP, "Courant Number mean: %g max: %g\n",
-                      sim->courant_mean, sim->courant_max);
+        double courant_mean = 0, courant_max = 0;
+        courant(sim, dt, &courant_mean, &courant_max);
+        mf_log_printf(sim->log, MF_LOG_STEP, "Courant Number mean: %g max: %g\n", courant_mean,
+                      courant_max);
         mf_log_printf(sim->log, MF_LOG_STEP, "deltaT = %g\n", dt);
         mf_log_printf(sim->log, MF_LOG_STEP, "Time = %.10g\n\n", sim->time + dt);
         double kinetic_in = 0;
         int rc = apply_emitters(run, dt, &kinetic_in, &added, &removed);
         run->watch.work = work0 + kinetic_in;
+        sim->forces_record.valid = false; /* set again by this attempt's forces */
         if (rc == 0)
-            rc = run->solver_ops->step(run->solver->data, sim, dt);
+            rc = mf_solver_step(run->solver, sim, dt);
         /* One outcome for every rank: all retry, stop or go on together. */
         rc = mf_parallel_agree(sim->par, rc);
         if (rc == 0) {
@@ -302,6 +316,7 @@ static int step_once(mf_run *run, saved_state *saved, double next_write)
         sim->time = saved->time;
         run->retries++;
         dt *= 0.5;
+        land = NAN; /* half the step no longer reaches the target */
         run->sim->dt_natural = dt;
     }
     (void)limiter;
@@ -310,7 +325,7 @@ static int step_once(mf_run *run, saved_state *saved, double next_write)
         sim->emitters->total_removed += removed;
     }
     mf_watch_accept(&run->watch);
-    sim->time += dt;
+    sim->time = isnan(land) ? sim->time + dt : land;
     sim->step++;
     run->steps++;
     int rc = 0;
@@ -320,6 +335,19 @@ static int step_once(mf_run *run, saved_state *saved, double next_write)
     }
     MF_CALL(mf_parallel_agree(sim->par, rc));
     return 0;
+}
+
+/* The write time after `next_write`. Write times are k times the interval
+ * (mf_run_first_write), never sums of it: a run restarted at a write time
+ * finds the same next write time to the bit as the run that wrote it (0.002
+ * added nine times is not 9 x 0.002, and the step that lands on it would
+ * differ). With writeControl timeStep they are step counts, exact either way. */
+static double next_write_after(const mf_run *run, double next_write)
+{
+    const double interval = run->ctl.write_interval;
+    if (run->ctl.write_by_steps)
+        return next_write + interval;
+    return (floor(next_write / interval + 0.5) + 1) * interval;
 }
 
 int mf_run_loop(mf_run *run, bool write_initial)
@@ -349,6 +377,16 @@ int mf_run_loop(mf_run *run, bool write_initial)
         mf_log_printf(sim->log, MF_LOG_NORMAL,
                       "Watch: no density-collapse check, nozzles add thin jets of fluid\n");
     }
+    if (!run->ctl.adjust) { /* a fixed step is the user's choice: say when it is too long */
+        double sdt = INFINITY;
+        const char *who = NULL;
+        MF_CALL_GOTO(rc, mf_stable_dt(run->solver, sim, &sdt, &who), done);
+        if (run->ctl.delta_t > sdt)
+            mf_log_printf(sim->log, MF_LOG_QUIET,
+                          "Warning: deltaT %g s is above the stable step of %s, %g s "
+                          "(adjustTimeStep no keeps it): the run may go unstable\n",
+                          run->ctl.delta_t, who, sdt);
+    }
     if (write_initial)
         MF_CALL_GOTO(rc, write_now(run), done);
     mf_log_printf(sim->log, MF_LOG_NORMAL, "\nStarting time loop\n\n");
@@ -375,7 +413,7 @@ int mf_run_loop(mf_run *run, bool write_initial)
         if (wrote) {
             MF_CALL_GOTO(rc, write_now(run), done);
             while (next_write <= (run->ctl.write_by_steps ? (double)sim->step : sim->time * (1 + 1e-9)))
-                next_write += run->ctl.write_interval;
+                next_write = next_write_after(run, next_write);
         }
         double wall = mf_wall_seconds() - t0;
         mf_log_printf(sim->log, MF_LOG_STEP, "ExecutionTime = %.3f s  ClockTime = %.0f s\n\n",

@@ -99,14 +99,12 @@ int mf_run_between_steps(mf_run *run, bool wrote, double *next_write, bool *stop
         if (sim->par) {
             struct {
                 mf_run_control ctl;
-                double end_time, max_courant, max_dt;
+                double end_time;
                 int watching;
-            } b = {run->ctl, sim->end_time, sim->max_courant, sim->max_dt, run->modified != NULL};
+            } b = {run->ctl, sim->end_time, run->modified != NULL};
             mf_parallel_bcast(sim->par, &b, sizeof b, 0);
             run->ctl = b.ctl;
             sim->end_time = b.end_time;
-            sim->max_courant = b.max_courant;
-            sim->max_dt = b.max_dt;
             if (!b.watching)
                 run->modified = NULL;
         }

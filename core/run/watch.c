@@ -8,6 +8,7 @@
 
 #include "mf_error.h"
 #include "mf_modules.h"
+#include "mf_scene.h"
 
 const mf_param mf_watch_params[] = {
     {"enabled", MF_PARAM_BOOL, "yes", MF_NO_RANGE, NULL, offsetof(mf_watch_settings, enabled),
@@ -28,20 +29,6 @@ int mf_watch_init(mf_watch *w, const mf_dict *dict, mf_dict *resolved)
     static const char *const extra[] = {NULL};
     MF_CALL(mf_params_apply(mf_watch_params, mf_watch_nparams, dict, extra, &w->s, resolved));
     return 0;
-}
-
-void mf_watch_free(mf_watch *w)
-{
-    free(w->acc);
-    w->acc = NULL;
-}
-
-/* Mass of particle i: rho l0^d of its fluid (FluidId when there are several). */
-static double particle_mass(const mf_sim *sim, int fluid_field, size_t i)
-{
-    int f = fluid_field >= 0 ? mf_particles_fi(sim->p, fluid_field)[i] : 0;
-    double vol = sim->dim == 3 ? sim->l0 * sim->l0 * sim->l0 : sim->l0 * sim->l0;
-    return sim->fluid[f].rho * vol;
 }
 
 static int check_non_finite(const mf_sim *sim)
@@ -72,42 +59,25 @@ static int check_non_finite(const mf_sim *sim)
 }
 
 /* A fluid centre past the wall-particle line (l0/2 outside the enclosed
- * region) of a closed face, within that face's extent, went through it. */
+ * region) of a closed face, within that face's extent, went through it
+ * (mf_scene_past_wall: the dry run refuses a scene that starts so). */
 static int check_walls(const mf_sim *sim)
 {
     const mf_particles *p = sim->p;
-    const double h = 0.5 * sim->l0;
-    for (size_t b = 0; b < sim->nwall_boxes; b++) {
-        const mf_wall_box *box = &sim->wall_boxes[b];
-        for (size_t i = 0; i < p->n_owned; i++) {
-            if (p->kind[i] != MF_FLUID)
-                continue;
-            const double *x = &p->pos[3 * i];
-            for (int a = 0; a < sim->dim; a++) {
-                for (int side = 0; side < 2; side++) {
-                    if (box->open[a][side])
-                        continue;
-                    bool past = side == 0 ? x[a] < box->min[a] - h : x[a] > box->max[a] + h;
-                    if (!past)
-                        continue;
-                    bool within = true;
-                    for (int o = 0; o < sim->dim; o++)
-                        if (o != a && (x[o] < box->min[o] - h || x[o] > box->max[o] + h))
-                            within = false;
-                    if (!within)
-                        continue;
-                    static const char *const faces[3][2] = {
-                        {"xmin", "xmax"}, {"ymin", "ymax"}, {"zmin", "zmax"}};
-                    return MF_ERROR(MF_ERR_NUMERIC,
-                                    "unstable (throughWall) at time %g, step %ld: fluid particle "
-                                    "id %lld at (%g %g %g) is past the %s wall of wall box %zu, "
-                                    "moving at (%g %g %g) m/s",
-                                    sim->time, sim->step, (long long)p->id[i], x[0], x[1], x[2],
-                                    faces[a][side], b + 1, p->vel[3 * i], p->vel[3 * i + 1],
-                                    p->vel[3 * i + 2]);
-                }
-            }
-        }
+    static const char *const faces[3][2] = {{"xmin", "xmax"}, {"ymin", "ymax"}, {"zmin", "zmax"}};
+    for (size_t i = 0; i < p->n_owned; i++) {
+        size_t b;
+        int a, side;
+        if (p->kind[i] != MF_FLUID || !mf_scene_past_wall(sim, i, &b, &a, &side))
+            continue;
+        const double *x = &p->pos[3 * i];
+        return MF_ERROR(MF_ERR_NUMERIC,
+                        "unstable (throughWall) at time %g, step %ld: fluid particle "
+                        "id %lld at (%g %g %g) is past the %s wall of wall box %zu, "
+                        "moving at (%g %g %g) m/s",
+                        sim->time, sim->step, (long long)p->id[i], x[0], x[1], x[2],
+                        faces[a][side], b + 1, p->vel[3 * i], p->vel[3 * i + 1],
+                        p->vel[3 * i + 2]);
     }
     return 0;
 }
@@ -152,38 +122,37 @@ static int check_density(mf_watch *w, const mf_sim *sim)
                     (long long)t.id, x[0], x[1], x[2]);
 }
 
-/* Kinetic energy, and the power of the force modules (sum m a.v). */
-static int energy(mf_watch *w, const mf_sim *sim, double *ke, double *power, double *mass_acc)
+/* Kinetic energy; the power of the step's force accelerations a^n (what
+ * mf_force_accumulate recorded, carried with the particles in the
+ * ForceAcceleration field) at the end of the step, sum m a^n.u^{n+1}, and at
+ * its start (the record's power, sum m a^n.u^n); and sum m |a^n|. A step
+ * whose forces did not run (no forces) has none. */
+static void energy(const mf_sim *sim, double *ke, double *power_start, double *power_end,
+                   double *mass_acc)
 {
     const mf_particles *p = sim->p;
-    if (w->cap < p->n) {
-        free(w->acc);
-        w->cap = p->n + p->n / 4 + 16;
-        w->acc = malloc(3 * w->cap * sizeof *w->acc);
-        if (!w->acc)
-            return MF_ERROR(MF_ERR_MEMORY, "out of memory in the run's watch");
-    }
-    memset(w->acc, 0, 3 * p->n * sizeof *w->acc);
-    for (size_t k = 0; k < sim->nforces; k++) {
-        const mf_force_ops *ops = (const mf_force_ops *)sim->forces[k].info;
-        MF_CALL(ops->accumulate(sim->forces[k].data, sim, w->acc));
-    }
-    int ff = mf_particles_field_index(p, "FluidId");
-    *ke = *power = *mass_acc = 0;
+    const int ff = mf_particles_field_index(p, "FluidId");
+    const int fa = sim->forces_record.valid ? mf_particles_field_index(p, MF_FORCE_FIELD) : -1;
+    const double *acc = fa >= 0 ? mf_particles_fd(p, fa) : NULL;
+    *ke = *power_end = *mass_acc = 0;
+    *power_start = acc ? sim->forces_record.power : 0;
     for (size_t i = 0; i < p->n_owned; i++) {
         if (p->kind[i] != MF_FLUID)
             continue;
-        const double m = particle_mass(sim, ff, i), *v = &p->vel[3 * i], *a = &w->acc[3 * i];
+        const double m = mf_sim_particle_mass(sim, ff, i), *v = &p->vel[3 * i];
         *ke += 0.5 * m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-        *power += m * (a[0] * v[0] + a[1] * v[1] + a[2] * v[2]);
+        if (!acc)
+            continue;
+        const double *a = &acc[3 * i];
+        *power_end += m * (a[0] * v[0] + a[1] * v[1] + a[2] * v[2]);
         *mass_acc += m * sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
     }
-    double sums[3] = {*ke, *power, *mass_acc}; /* over the ranks */
-    mf_parallel_sum(sim->par, sums, 3);
+    double sums[4] = {*ke, *power_start, *power_end, *mass_acc}; /* over the ranks */
+    mf_parallel_sum(sim->par, sums, 4);
     *ke = sums[0];
-    *power = sums[1];
-    *mass_acc = sums[2];
-    return 0;
+    *power_start = sums[1];
+    *power_end = sums[2];
+    *mass_acc = sums[3];
 }
 
 static double fluid_extent(const mf_sim *sim)
@@ -251,19 +220,18 @@ static size_t fastest_fluid(const mf_sim *sim, double *speed)
 
 static int check_energy(mf_watch *w, const mf_sim *sim, double dt)
 {
-    double ke = 0, power = 0, mass_acc = 0;
-    MF_CALL(energy(w, sim, &ke, &power, &mass_acc));
+    double ke = 0, power_start = 0, power_end = 0, mass_acc = 0;
+    energy(sim, &ke, &power_start, &power_end, &mass_acc);
     if (!w->started) { /* the state the run starts from (after its first step) */
         w->started = true;
         w->ke0 = ke;
         w->pot_scale = mass_acc * fluid_extent(sim) + surface_energy(sim);
         w->next_work = 0;
-        w->next_power = power;
         return 0;
     }
-    /* Trapezoidal rule between the last accepted step and this one. */
-    w->next_work = w->work + 0.5 * (w->power + power) * dt;
-    w->next_power = power;
+    /* The work of the step's forces, a^n held over the step while u goes
+     * from u^n to u^{n+1}: the trapezoidal rule in u. */
+    w->next_work = w->work + 0.5 * (power_start + power_end) * dt;
     double excess = ke - w->ke0 - w->next_work;
     double scale = w->ke0 + fabs(w->next_work) + w->pot_scale;
     if (!(scale > 0 && excess > w->s.energy_tolerance * scale))
@@ -303,5 +271,4 @@ int mf_watch_check(mf_watch *w, const mf_sim *sim, double dt)
 void mf_watch_accept(mf_watch *w)
 {
     w->work = w->next_work;
-    w->power = w->next_power;
 }

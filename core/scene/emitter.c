@@ -907,3 +907,22 @@ double mf_emitters_fluid_kinetic_energy(const mf_sim *sim)
     }
     return ke;
 }
+
+#define NP(t) (sizeof(t) / sizeof((t)[0]))
+const mf_param_section mf_emitter_sections[] = {
+    {"geometry: inlets/<name>", "a buffer of points entering at a given velocity", inlet_params,
+     NP(inlet_params)},
+    {"geometry: outlets/<name>", "a buffer where fluid leaves and is removed", outlet_params,
+     NP(outlet_params)},
+    {"geometry: emitters/<name>, type nozzle", "fluid added across an opening for a time window",
+     nozzle_params, NP(nozzle_params)},
+    {"geometry: scalars/<name>, type uniform", "a transported scalar's initial value (also `NAME v;`)",
+     uniform_params, NP(uniform_params)},
+    {"geometry: scalars/<name>, type gaussian", "b + a exp(-d^2 / (2 s^2))", gaussian_params,
+     NP(gaussian_params)},
+    {"geometry: scalars/<name>, type step", "one value behind a plane, another ahead",
+     step_params, NP(step_params)},
+    {"geometry: scalars/<name>, type box", "one value inside a box, another outside", box_params,
+     NP(box_params)},
+};
+const size_t mf_emitter_nsections = NP(mf_emitter_sections);

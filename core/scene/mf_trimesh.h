@@ -147,6 +147,10 @@ bool mf_scene_entry_is_mesh(const mf_dict *entry);
 int mf_scene_meshes_create(const mf_dict *geometry, const mf_trimesh_reader *reader, int dim,
                            double l0, mf_log *log, mf_scene_meshes **out);
 void mf_scene_meshes_destroy(mf_scene_meshes *sm);
+/* Particles the meshes will make on the lattice (for the memory budget):
+ * a fluid mesh its bounding box's volume over l0^dim, a wall or obstacle
+ * its area (3-D) or its bounding box's perimeter (2-D) times its layers. */
+double mf_scene_meshes_estimate(const mf_scene_meshes *sm);
 
 /* A fluid block `type mesh`: fill the closed surface with fluid particles
  * (fluid_field: the FluidId field or -1). */

@@ -384,6 +384,16 @@ static const mf_param fluid_mesh_params[] = {
 };
 #define NPARAMS(t) (sizeof(t) / sizeof((t)[0]))
 
+const mf_param_section mf_mesh_sections[] = {
+    {"geometry: walls/<name>, type mesh", "a wall made from a polygon file (mf_trimesh.h)",
+     wall_mesh_params, NPARAMS(wall_mesh_params)},
+    {"geometry: obstacles/<name>", "a solid body in the fluid, from a polygon file",
+     obstacle_mesh_params, NPARAMS(obstacle_mesh_params)},
+    {"geometry: fluidBlocks/<name>, type mesh", "fluid filling a closed polygon surface",
+     fluid_mesh_params, NPARAMS(fluid_mesh_params)},
+};
+const size_t mf_mesh_nsections = NPARAMS(mf_mesh_sections);
+
 static const mf_param *params_of(const char *group, size_t *n)
 {
     if (strcmp(group, "fluidBlocks") == 0) {
@@ -462,9 +472,14 @@ static int load_item(mf_scene_meshes *sm, const mf_trimesh_reader *reader, mesh_
     int rc = reader->read(reader->ctx, s.file, fe->loc.file, &it->mesh);
     if (rc != 0)
         return MF_ERROR(rc, "%s: %s: %s", floc, it->label, mf_error_message());
+    /* A face with fewer than three corners is what a file cut short in the
+     * middle of a face line reads as: refuse it rather than build half a wall. */
     if (it->mesh.dropped)
-        warn(sm, it, "%zu points or lines ignored (only triangles and polygons make surfaces)",
-             it->mesh.dropped);
+        return MF_ERROR(MF_ERR_INPUT,
+                        "%s: %s: %s holds %zu points or lines beside its triangles (a file cut "
+                        "short in the middle of a face, or edges drawn in it); only triangles "
+                        "and polygons make surfaces: repair or re-export the file",
+                        floc, it->label, it->mesh.name, it->mesh.dropped);
     if (it->scale != 1)
         mf_trimesh_scale(&it->mesh, it->scale);
     rc = mf_trimesh_check(&it->mesh, &it->rep);
@@ -585,6 +600,36 @@ int mf_scene_meshes_create(const mf_dict *geometry, const mf_trimesh_reader *rea
         }
     }
     return check_units(sm, rmin, rmax, have_ref);
+}
+
+double mf_scene_meshes_estimate(const mf_scene_meshes *sm)
+{
+    double count = 0;
+    for (size_t i = 0; sm && i < sm->n; i++) {
+        const mesh_item *it = &sm->item[i];
+        const int dim = sm->L.dim;
+        const double l0 = sm->L.l0;
+        double mn[3], mx[3];
+        mf_trimesh_bounds(&it->mesh, mn, mx);
+        if (strcmp(it->group, "fluidBlocks") == 0) {
+            double v = 1;
+            for (int a = 0; a < dim; a++)
+                v *= floor((mx[a] - mn[a]) / l0) + 1;
+            count += v;
+            continue;
+        }
+        double layers = 3; /* wallLayers + dummyLayers by default */
+        double w = 1, d = 2;
+        if (mf_dict_get_number_or(it->dict, "wallLayers", 1, &w) == 0 &&
+            mf_dict_get_number_or(it->dict, "dummyLayers", 2, &d) == 0)
+            layers = w + d;
+        mf_error_clear();
+        if (dim == 3)
+            count += it->rep.area / (l0 * l0) * (layers + 1);
+        else
+            count += 2 * ((mx[0] - mn[0]) + (mx[1] - mn[1])) / l0 * (layers + 1);
+    }
+    return count;
 }
 
 void mf_scene_meshes_destroy(mf_scene_meshes *sm)
@@ -813,7 +858,8 @@ int mf_scene_mesh_wall(mf_scene_meshes *sm, mf_sim *sim, const char *name, const
         keys[nkeys++] = b.key[e] | (wall ? 1ULL << 63 : 0);
     }
     if (rc == 0) {
-        qsort(keys, nkeys, sizeof *keys, cmp_u64);
+        if (nkeys > 1)
+            qsort(keys, nkeys, sizeof *keys, cmp_u64);
         for (size_t k = 0; rc == 0 && k < nkeys; k++) {
             int kind = keys[k] >> 63 ? MF_WALL : MF_DUMMY;
             rc = place_fixed(sm, sim, keys[k] & ~(1ULL << 63), kind, &nwall, &ndummy);
@@ -916,7 +962,8 @@ static int fill_points(const mesh_item *it, const lattice *L, int out_sign, cons
                                        delta};
             }
     }
-    qsort(cr, ncr, sizeof *cr, cmp_crossing);
+    if (ncr > 1) /* qsort may not be handed NULL, which cr is with no crossing */
+        qsort(cr, ncr, sizeof *cr, cmp_crossing);
     uint64_t *keys = NULL;
     size_t nkeys = 0, capk = 0;
     for (size_t s = 0; s < ncr;) {

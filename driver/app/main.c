@@ -7,6 +7,7 @@
  *   mpirun -np N mpsflow -parallel -case DIR     (one case on N ranks)
  */
 #include <limits.h>
+#include <math.h>
 #include <mpi.h>
 #include <HYPRE_utilities.h>
 #include <stdlib.h>
@@ -25,6 +26,9 @@ static void usage(FILE *f)
             "Commands:\n"
             "  (none)            run the case\n"
             "  modules [NAME]    list the registered modules by kind, or the parameters of one\n"
+            "                    (also of a case dictionary: controlDict, watch, geometry,\n"
+            "                    fluids, validation, compareDict, stabilityDict)\n"
+            "  reference [FILE]  every key of every dictionary and module, as markdown\n"
             "  validate          score the case's output against its reference (validation/)\n"
             "  compare           run the case with several schemes and resolutions: error\n"
             "                    against run time (-solvers '(A B)' -resolutions '(l0 ...)')\n"
@@ -67,8 +71,8 @@ static int parse_number(const char *opt, const char *text, double *out)
 {
     char *end;
     *out = strtod(text, &end);
-    if (end == text || *end || !(*out > 0))
-        return MF_ERROR(MF_ERR_INPUT, "%s takes a positive number, not '%s'", opt, text);
+    if (end == text || *end || !(*out > 0) || !isfinite(*out))
+        return MF_ERROR(MF_ERR_INPUT, "%s takes a positive finite number, not '%s'", opt, text);
     return 0;
 }
 
@@ -171,25 +175,33 @@ int mf_cmd_modules(mf_registry *reg, const char *name)
 {
     if (!name) {
         mf_registry_print(reg, stdout);
+        printf("case dictionaries (mpsflow modules NAME):\n   ");
+        for (size_t k = 0; mf_dict_table_names[k]; k++)
+            printf(" %s", mf_dict_table_names[k]);
+        printf("\n");
         return 0;
     }
+    if (mf_dict_tables_print(name, stdout))
+        return 0;
     const mf_module_info *m = mf_registry_lookup_any(reg, name);
     if (!m) {
-        /* Let the registry's error list every name of every kind. */
-        const mf_module_info *found;
-        int rc = mf_registry_find(reg, MF_KIND_SOLVER, name, &found);
-        for (int k = 1; k < MF_KIND_COUNT && rc != 0; k++) {
-            char first[2048];
-            snprintf(first, sizeof first, "%s", mf_error_message());
-            mf_error_clear();
-            rc = mf_registry_find(reg, (mf_module_kind)k, name, &found);
-            if (rc != 0) {
-                char both[4200];
-                snprintf(both, sizeof both, "%s; %s", first, mf_error_message());
-                rc = MF_ERROR(MF_ERR_INPUT, "%s", both);
-            }
+        /* Suggest from every module of every kind and the case dictionaries. */
+        const char *names[512];
+        size_t n = 0;
+        char list[4096] = "";
+        for (int k = 0; k < MF_KIND_COUNT; k++)
+            for (size_t i = 0; i < mf_registry_count(reg, (mf_module_kind)k) && n < 500; i++)
+                names[n++] = mf_registry_at(reg, (mf_module_kind)k, i)->name;
+        for (size_t k = 0; mf_dict_table_names[k] && n < 512; k++)
+            names[n++] = mf_dict_table_names[k];
+        for (size_t k = 0; k < n; k++) {
+            strncat(list, k ? ", " : "", sizeof list - strlen(list) - 1);
+            strncat(list, names[k], sizeof list - strlen(list) - 1);
         }
-        return MF_ERROR(MF_ERR_INPUT, "no module named '%s'. %s", name, mf_error_message());
+        const char *hint = mf_did_you_mean(name, names, n);
+        return MF_ERROR(MF_ERR_INPUT, "no module or case dictionary named '%s'%s%s%s; known: %s",
+                        name, hint ? " (did you mean '" : "", hint ? hint : "", hint ? "'?)" : "",
+                        list);
     }
     printf("%s (%s module): %s\n", m->name, mf_module_kind_name(m->kind), m->summary);
     printf("Parameters:\n");
@@ -200,6 +212,12 @@ int mf_cmd_modules(mf_registry *reg, const char *name)
 /* The run itself; every rank of a -parallel run calls it. */
 static int run_case(mf_app *app)
 {
+    /* Stale .tmp files of a killed run: one rank looks (and says so). */
+    int stale = 0;
+    MF_CALL(mf_parallel_agree(app->sim.par,
+                              mf_parallel_is_root(app->sim.par)
+                                  ? mf_app_remove_stale_tmp(app->cs.dir, &app->log, &stale)
+                                  : 0));
     bool restart = mf_app_is_restart(app);
     if (restart) {
         const mf_writer_ops *w = (const mf_writer_ops *)app->writer.info;
@@ -227,6 +245,13 @@ static int run_case(mf_app *app)
     if (ops->report)
         ops->report(app->solver.data, &app->sim, &app->log);
     mf_app_report_parallel(app);
+    /* What the calling wrappers counted (mf_modules.h). */
+    mf_log_printf(&app->log, MF_LOG_QUIET, "Solver %s: %ld steps, %.3f s\n",
+                  app->solver.info->name, app->solver.calls, app->solver.seconds);
+    for (size_t k = 0; k < app->sim.nforces; k++)
+        mf_log_printf(&app->log, MF_LOG_QUIET, "Force %s: %ld calls, %.3f s\n",
+                      app->sim.forces[k].info->name, app->sim.forces[k].calls,
+                      app->sim.forces[k].seconds);
     mf_log_printf(&app->log, MF_LOG_QUIET,
                   "\nSteps %ld (retried %ld), snapshots %d, wall time %.2f s, peak memory %.1f "
                   "MB\n",
@@ -262,8 +287,27 @@ int mf_cmd_run(mf_app *app)
     return rc;
 }
 
+/* OpenMP's wait policy, before anything else. libgomp's default spins a
+ * waiting thread for up to 300,000 iterations at every barrier; when
+ * another process holds the second core, the team's other thread is not
+ * running, every barrier waits out a time slice, and two threads made a step
+ * 25 to 40 times slower than one (the neighbour search: 1 ms to 400 ms).
+ * Passive waiting (sleep at once) keeps two threads at or below one thread's
+ * time on a loaded machine (docs/incoming/iface.md has the measurements).
+ * libgomp reads the policy from the environment when it loads, before main:
+ * so set it and start again, unless the user chose a policy. */
+static void openmp_wait_policy(char **argv)
+{
+    if (getenv("OMP_WAIT_POLICY") || getenv("GOMP_SPINCOUNT"))
+        return;
+    if (setenv("OMP_WAIT_POLICY", "PASSIVE", 1) != 0)
+        return;
+    execv("/proc/self/exe", argv); /* returns only on failure: go on as we are */
+}
+
 int main(int argc, char **argv)
 {
+    openmp_wait_policy(argv);
     /* Whole lines reach a redirected log at once (tail -f, a kill). */
     setvbuf(stdout, NULL, _IOLBF, 0);
     mf_app app;
@@ -281,7 +325,8 @@ int main(int argc, char **argv)
     if (command && !strcmp(command, "surface"))
         return mf_main_surface(argc, argv, first);
     const char *module_name = NULL;
-    if (command && !strcmp(command, "modules") && argc > 2 && argv[2][0] != '-') {
+    if (command && (!strcmp(command, "modules") || !strcmp(command, "reference")) && argc > 2 &&
+        argv[2][0] != '-') {
         module_name = argv[2];
         first = 3;
     }
@@ -299,7 +344,7 @@ int main(int argc, char **argv)
         return 0;
     }
     static const char *const commands[] = {"modules", "validate", "compare", "stability",
-                                           "listTimes"};
+                                           "listTimes", "reference"};
     const size_t ncommands = sizeof commands / sizeof commands[0];
     bool known = !command;
     for (size_t k = 0; k < ncommands && !known; k++)
@@ -349,6 +394,8 @@ int main(int argc, char **argv)
         rc = mf_cmd_list_times(&app.opt);
     else if (rc == 0 && !strcmp(command, "modules") && root)
         rc = mf_cmd_modules(app.reg, module_name);
+    else if (rc == 0 && !strcmp(command, "reference") && root)
+        rc = mf_cmd_reference(app.reg, module_name);
     else if (rc == 0 && !strcmp(command, "validate") && root)
         rc = mf_cmd_validate(app.opt.case_dir, &error);
     else if (rc == 0 && !strcmp(command, "compare"))

@@ -10,6 +10,7 @@
 #include "mf_case.h"
 #include "mf_modules.h"
 #include "mf_run.h"
+#include "mf_scene.h"
 #include "mf_sim.h"
 
 typedef struct mf_options {
@@ -49,6 +50,7 @@ typedef struct mf_app {
     mf_module *functions;
     mf_run run;
     bool error_agreed;      /* a -parallel run's failure is known to every rank */
+    mf_scene_budget budget; /* the memory estimate the scene was checked against */
     mf_control_watch control_watch;
 } mf_app;
 
@@ -64,6 +66,13 @@ int mf_app_load_case_libs(mf_app *app);
 /* Read the case, build the scene and create the modules it names. */
 int mf_app_setup(mf_app *app);
 void mf_app_teardown(mf_app *app);
+/* The memory budget of the case's scene (memory_budget.c): maxMemory, or
+ * 80% of the machine's memory, and the bytes a particle costs at the
+ * solver's largest neighbour radius. */
+int mf_app_memory_budget(mf_app *app, mf_scene_budget *b);
+/* Remove the *.tmp files a killed run left in output/ and postProcessing/
+ * (stale_tmp.c), logging each; *removed counts them. */
+int mf_app_remove_stale_tmp(const char *case_dir, mf_log *log, int *removed);
 /* Print counts, kernel constants and memory (-dryRun). */
 void mf_app_summary(const mf_app *app);
 
@@ -81,6 +90,23 @@ void mf_app_report_parallel(const mf_app *app);
  * stopped early, by stopAt or a signal, says so from app->run.stop_reason). */
 int mf_write_run_summary(const mf_app *app, int status);
 
+/* The tables of compareDict and stabilityDict (runs.c, stability.c), and
+ * every table of every case dictionary and module (dict_tables.c): what
+ * `mpsflow modules controlDict|geometry|fluids|watch|validation|compareDict|
+ * stabilityDict` and `mpsflow reference` print. */
+extern const mf_param mf_compare_params[];
+extern const mf_param_section mf_compare_sections[];
+extern const size_t mf_compare_nsections;
+extern const mf_param_section mf_stability_sections[];
+extern const size_t mf_stability_nsections;
+extern const mf_param_section mf_decompose_sections[]; /* parallel_setup.c */
+extern const size_t mf_decompose_nsections;
+/* Print the tables of the case dictionary `name` (false: no such one). */
+bool mf_dict_tables_print(const char *name, FILE *f);
+/* The names mf_dict_tables_print knows, NULL-terminated. */
+extern const char *const mf_dict_table_names[];
+/* docs/reference.md: every dictionary's and every module's keys. */
+int mf_cmd_reference(mf_registry *reg, const char *path);
 /* -latestTime or startFrom latestTime. */
 bool mf_app_is_restart(const mf_app *app);
 /* A fresh run refuses an output/ that holds an earlier run, or removes it

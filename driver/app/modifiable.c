@@ -56,15 +56,12 @@ static void say(mf_app *app, const char *key, double from, double to)
 
 /* A key whose value in the file changed: the run takes it (and `also`, a
  * copy kept elsewhere, may be NULL). */
-static void take(mf_app *app, const char *key, double fresh, double before, double *dst,
-                 double *also)
+static void take(mf_app *app, const char *key, double fresh, double before, double *dst)
 {
     if (fresh == before)
         return;
     say(app, key, *dst, fresh);
     *dst = fresh;
-    if (also)
-        *also = fresh;
 }
 
 static void take_long(mf_app *app, const char *key, long fresh, long before, long *dst)
@@ -96,7 +93,7 @@ int mf_app_control_modified(void *ctx, mf_run *run)
     mf_run_control *c = &run->ctl;
     mf_sim *sim = run->sim;
     const mf_control *was = &w->file;
-    take(app, "endTime", fresh.end_time, was->end_time, &sim->end_time, NULL);
+    take(app, "endTime", fresh.end_time, was->end_time, &sim->end_time);
     if (strcmp(fresh.stop_at, was->stop_at) != 0) {
         mf_stop_at s = MF_STOP_END_TIME;
         MF_CALL(mf_stop_at_parse(fresh.stop_at, &s));
@@ -104,12 +101,12 @@ int mf_app_control_modified(void *ctx, mf_run *run)
                       mf_stop_at_name(c->stop_at), fresh.stop_at, sim->time);
         c->stop_at = s;
     }
-    take(app, "writeInterval", fresh.write_interval, was->write_interval, &c->write_interval, NULL);
-    take(app, "deltaT", fresh.delta_t, was->delta_t, &c->delta_t, NULL);
-    take(app, "maxCo", fresh.max_co, was->max_co, &c->max_co, &sim->max_courant);
-    take(app, "maxDi", fresh.max_di, was->max_di, &c->max_di, NULL);
-    take(app, "maxDeltaT", fresh.max_delta_t, was->max_delta_t, &c->max_delta_t, &sim->max_dt);
-    take(app, "minDeltaT", fresh.min_delta_t, was->min_delta_t, &c->min_delta_t, NULL);
+    take(app, "writeInterval", fresh.write_interval, was->write_interval, &c->write_interval);
+    take(app, "deltaT", fresh.delta_t, was->delta_t, &c->delta_t);
+    take(app, "maxCo", fresh.max_co, was->max_co, &c->max_co);
+    take(app, "maxDi", fresh.max_di, was->max_di, &c->max_di);
+    take(app, "maxDeltaT", fresh.max_delta_t, was->max_delta_t, &c->max_delta_t);
+    take(app, "minDeltaT", fresh.min_delta_t, was->min_delta_t, &c->min_delta_t);
     take_long(app, "maxRetries", fresh.max_retries, was->max_retries, &c->max_retries);
     take_long(app, "purgeWrite", fresh.purge_write, was->purge_write, &c->purge_write);
     if (!fresh.run_time_modifiable) {

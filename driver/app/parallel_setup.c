@@ -64,6 +64,18 @@ static const mf_param weight_params[] = {
      "load of an outlet particle"},
 };
 
+const mf_param_section mf_decompose_sections[] = {
+    {"decomposeParDict",
+     "system/decomposeParDict (optional, read by -parallel runs on more than one rank): how "
+     "Zoltan splits the particles over the ranks",
+     decompose_params, sizeof decompose_params / sizeof decompose_params[0]},
+    {"decomposeParDict: weights",
+     "its weights {} block: the load of a particle of each kind, relative to a fluid particle "
+     "(measured: instructions a step per particle of the 3-D dam break)",
+     weight_params, sizeof weight_params / sizeof weight_params[0]},
+};
+const size_t mf_decompose_nsections = 2;
+
 int mf_app_check_parallel(const mf_options *opt, int argc, char **argv)
 {
     const int nprocs = mf_parallel_world_size();

@@ -2,6 +2,7 @@
 #include "mf_runs.h"
 
 #include <errno.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -135,6 +136,21 @@ int mf_parse_option_list(const char *option, const char *text, mf_dict **tree,
     return 0;
 }
 
+typedef struct compare_settings {
+    const mf_dict *variants;
+} compare_settings;
+
+const mf_param mf_compare_params[] = {
+    {"variants", MF_PARAM_DICT, NULL, MF_NO_RANGE, NULL, offsetof(compare_settings, variants),
+     "one sub-dictionary per scheme: entries that replace those of solverDict (sub-dictionaries "
+     "merge), e.g. MPS_plain { MPSCoeffs { relaxation 1; } }"},
+};
+const mf_param_section mf_compare_sections[] = {
+    {"compareDict", "system/compareDict: the schemes `mpsflow compare` can name", mf_compare_params,
+     1},
+};
+const size_t mf_compare_nsections = 1;
+
 int mf_case_apply_scheme(const char *run_dir, const char *case_dir, const char *scheme)
 {
     char path[4400], comment[4600];
@@ -145,6 +161,15 @@ int mf_case_apply_scheme(const char *run_dir, const char *case_dir, const char *
         MF_CALL(mf_dict_parse_file(path, &cd));
     snprintf(path, sizeof path, "%s/system/solverDict", case_dir);
     rc = mf_dict_parse_file(path, &sd);
+    if (cd) {
+        compare_settings cs;
+        static const char *const extra[] = {"FoamFile", NULL};
+        int crc = mf_params_apply(mf_compare_params, 1, cd, extra, &cs, NULL);
+        if (crc != 0) {
+            mf_dict_free(cd);
+            return mf_error_trace(crc, __FILE__, __LINE__, __func__);
+        }
+    }
     const mf_dict *variants = cd ? mf_dict_subdict(cd, "variants") : NULL;
     const mf_dict *v = variants ? mf_dict_subdict(variants, scheme) : NULL;
     if (rc == 0)

@@ -102,7 +102,7 @@ static int create_solver(mf_app *app, mf_dict *resolved)
     MF_CALL(mf_registry_find(app->reg, MF_KIND_SOLVER, name, &info));
     size_t ns = mf_registry_count(app->reg, MF_KIND_SOLVER);
     char(*names)[256] = calloc(ns + 1, sizeof *names);
-    const char **extra = calloc(ns + 6, sizeof *extra);
+    const char **extra = calloc(ns + 7, sizeof *extra);
     if (!names || !extra) {
         free(names);
         free(extra);
@@ -111,6 +111,7 @@ static int create_solver(mf_app *app, mf_dict *resolved)
     size_t ne = 0;
     extra[ne++] = "solver";
     extra[ne++] = "pressure";
+    extra[ne++] = "viscosity";
     extra[ne++] = "forces";
     extra[ne++] = "FoamFile";
     for (size_t k = 0; k < ns; k++) {
@@ -130,9 +131,13 @@ static int create_solver(mf_app *app, mf_dict *resolved)
     const mf_solver_ops *ops = (const mf_solver_ops *)app->solver.info;
     /* The solver reads `pressure` itself; it records what it used in rs. */
     MF_CALL(ops->create(app->solver.settings, &app->sim, sd, &app->solver.data));
-    const mf_dict *pd = mf_dict_subdict(sd, "pressure");
-    if (pd) {
-        mf_dict *rp = mf_dict_set_subdict(rs, "pressure");
+    /* The linear solvers' dictionaries as the case gave them. */
+    static const char *const solves[] = {"pressure", "viscosity"};
+    for (size_t s = 0; s < sizeof solves / sizeof *solves; s++) {
+        const mf_dict *pd = mf_dict_subdict(sd, solves[s]);
+        if (!pd)
+            continue;
+        mf_dict *rp = mf_dict_set_subdict(rs, solves[s]);
         for (size_t k = 0; k < pd->n; k++) {
             mf_entry *e = pd->entries[k];
             mf_value **items = calloc(e->n ? e->n : 1, sizeof *items);
@@ -213,16 +218,17 @@ int mf_app_setup(mf_app *app)
     MF_CALL(mf_app_load_case_libs(app));
     const mf_control *c = &app->cs.control;
     sim->time = c->start_time;
+    if (app->opt.end_time > 0)
+        MF_CALL(mf_case_check_end_time(c, app->opt.end_time, "-endTime"));
     sim->end_time = app->opt.end_time > 0 ? app->opt.end_time : c->end_time;
-    sim->max_courant = c->max_co;
-    sim->max_dt = c->max_delta_t;
-    sim->fixed_dt = !c->adjust_time_step;
     MF_CALL(mf_scene_read_fluids(app->cs.fluids, sim));
     mf_dict *resolved = app->cs.resolved;
     const mf_trimesh_reader mesh_reader = mf_mesh_import_reader(); /* polygon files */
-    MF_CALL(mf_scene_build_with_reader(app->cs.geometry, app->opt.l0, sim,
-                                       mf_dict_set_subdict(resolved, "geometry"), &mesh_reader));
-    MF_CALL(mf_scene_check_overlap(sim));
+    MF_CALL(mf_app_memory_budget(app, &app->budget));
+    MF_CALL(mf_scene_build_budgeted(app->cs.geometry, app->opt.l0, sim,
+                                    mf_dict_set_subdict(resolved, "geometry"), &mesh_reader,
+                                    &app->budget));
+    MF_CALL(mf_scene_check_start(app->cs.geometry, sim));
     mf_dict *rf = mf_dict_set_subdict(resolved, "fluids");
     for (int k = 0; k < sim->nfluids; k++) {
         mf_dict *f = mf_dict_set_subdict(rf, sim->fluid[k].name);
@@ -279,6 +285,7 @@ void mf_app_teardown(mf_app *app)
     if (app->solver.info && app->solver.data)
         ((const mf_solver_ops *)app->solver.info)->destroy(app->solver.data);
     mf_module_release(&app->solver);
+    app->sim.fault = (mf_fault_hook){0}; /* its context belongs to a force */
     for (size_t k = 0; k < app->sim.nforces; k++) {
         const mf_force_ops *ops = (const mf_force_ops *)app->sim.forces[k].info;
         if (app->sim.forces[k].data)
@@ -287,7 +294,6 @@ void mf_app_teardown(mf_app *app)
     }
     free(app->sim.forces);
     free(app->sim.wall_boxes);
-    mf_watch_free(&app->run.watch);
     mf_app_unwatch_control(app);
     mf_emitters_destroy(app->sim.emitters);
     app->sim.emitters = NULL;
@@ -330,4 +336,9 @@ void mf_app_summary(const mf_app *app)
     printf("Solver %s; time %g to %g s\n", app->solver.info->name, sim->time, sim->end_time);
     printf("Memory: particles %.2f MB; peak resident %.1f MB%s\n", memory[0], memory[1],
            sim->par ? " (the largest rank)" : "");
+    const mf_scene_budget *b = &app->budget;
+    if (b->bytes_per_particle > 0)
+        printf("Memory estimate: %.3g particles x %.0f bytes = %.3g GB of maxMemory %.3g GB (%s)\n",
+               b->particles, b->bytes_per_particle, b->particles * b->bytes_per_particle / 1e9,
+               b->max_bytes / 1e9, b->limit_source);
 }

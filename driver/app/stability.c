@@ -45,6 +45,29 @@ static const mf_param sweep_params[] = {
 };
 static const char *const sweep_extra[] = {"values", NULL};
 
+typedef struct stability_settings {
+    double end_time;
+    const mf_dict *overrides, *sweeps;
+} stability_settings;
+
+static const mf_param stability_params[] = {
+    {"endTime", MF_PARAM_SCALAR, "0", 0, 1e9, NULL, offsetof(stability_settings, end_time),
+     "end time of every run, s (0: the case's own; range as controlDict's endTime)"},
+    {"overrides", MF_PARAM_DICT, NULL, MF_NO_RANGE, NULL, offsetof(stability_settings, overrides),
+     "entries set in every run: { system/controlDict { maxDi 0; } ... }"},
+    {"sweeps", MF_PARAM_DICT, NULL, MF_NO_RANGE, NULL, offsetof(stability_settings, sweeps),
+     "one sub-dictionary per sweep: file, key and values (a b ...), the numbers tried"},
+};
+static const char *const stability_extra[] = {"FoamFile", NULL};
+
+const mf_param_section mf_stability_sections[] = {
+    {"stabilityDict", "system/stabilityDict: what `mpsflow stability` sweeps", stability_params,
+     sizeof stability_params / sizeof stability_params[0]},
+    {"stabilityDict: sweeps/<name>", "one parameter swept; `values (a b ...);` lists the numbers",
+     sweep_params, sizeof sweep_params / sizeof sweep_params[0]},
+};
+const size_t mf_stability_nsections = 2;
+
 /* Set FILE's entry at PATH (a/b/c) to the number x, in the run's copy. */
 static int set_parameter(const char *run_dir, const char *file, const char *key_path, double x)
 {
@@ -170,7 +193,10 @@ int mf_cmd_stability(const mf_options *o)
     mf_dict *sd = NULL, *stree = NULL, *otree = NULL;
     const mf_value *schemes = NULL, *only_list = NULL;
     MF_CALL(mf_dict_parse_file(path, &sd));
-    int rc = mf_parse_option_list("-solvers", solvers, &stree, &schemes);
+    stability_settings st;
+    int rc = mf_params_apply(stability_params, 3, sd, stability_extra, &st, NULL);
+    if (rc == 0)
+        rc = mf_parse_option_list("-solvers", solvers, &stree, &schemes);
     if (rc == 0 && only)
         rc = mf_parse_option_list("-sweeps", only, &otree, &only_list);
     const mf_dict *sweeps = mf_dict_subdict(sd, "sweeps");

@@ -333,7 +333,8 @@ static int laplace_evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double 
 
 const mf_metric mf_metric_laplace = {"laplacePressure",
                                      "pressure jump of a droplet at rest against Laplace",
-                                     laplace_evaluate};
+                                     laplace_evaluate,
+    laplace_params, sizeof laplace_params / sizeof laplace_params[0]};
 
 /* ---- oscillationPeriod ------------------------------------------------------ */
 
@@ -471,7 +472,8 @@ static int osc_evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *err
 
 const mf_metric mf_metric_oscillation = {"oscillationPeriod",
                                          "mode-2 oscillation period of a drop against Rayleigh",
-                                         osc_evaluate};
+                                         osc_evaluate,
+    osc_params, sizeof osc_params / sizeof osc_params[0]};
 
 /* ---- layering ------------------------------------------------------------------ */
 
@@ -580,7 +582,8 @@ static int layer_evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *e
 
 const mf_metric mf_metric_layering = {"layering",
                                       "two fluids settled: light above the interface height",
-                                      layer_evaluate};
+                                      layer_evaluate,
+    layer_params, sizeof layer_params / sizeof layer_params[0]};
 
 /* ---- rayleighTaylor -------------------------------------------------------------- */
 
@@ -687,7 +690,8 @@ static int rt_evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *erro
 }
 
 const mf_metric mf_metric_rayleigh_taylor = {
-    "rayleighTaylor", "spike and bubble of a Rayleigh-Taylor instability", rt_evaluate};
+    "rayleighTaylor", "spike and bubble of a Rayleigh-Taylor instability", rt_evaluate,
+    rt_params, sizeof rt_params / sizeof rt_params[0]};
 
 /* ---- fluidSurgeFront ------------------------------------------------------------ */
 /* The dam-break front of one fluid among several (the water of a water/air
@@ -811,4 +815,5 @@ static int front_evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *e
 }
 
 const mf_metric mf_metric_fluid_surge_front = {
-    "fluidSurgeFront", "dam-break surge front of one fluid among several", front_evaluate};
+    "fluidSurgeFront", "dam-break surge front of one fluid among several", front_evaluate,
+    front_params, sizeof front_params / sizeof front_params[0]};

@@ -133,4 +133,5 @@ static int evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
 }
 
 const mf_metric mf_metric_hydrostatic = {"hydrostaticPressure",
-                                         "time-averaged pressure of a resting column", evaluate};
+                                         "time-averaged pressure of a resting column", evaluate,
+    hydro_params, sizeof hydro_params / sizeof hydro_params[0]};

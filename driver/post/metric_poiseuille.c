@@ -169,4 +169,5 @@ static int evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
 const mf_metric mf_metric_poiseuille = {
     "poiseuille",
     "start-up of plane Poiseuille flow against Morris et al. (1997) eq. 21 (relative RMS of u)",
-    evaluate};
+    evaluate,
+    poiseuille_params, sizeof poiseuille_params / sizeof poiseuille_params[0]};

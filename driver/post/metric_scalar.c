@@ -182,7 +182,8 @@ static int evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
 
 const mf_metric mf_metric_scalar_advection = {
     "scalarAdvection", "a transported scalar against its initial profile shifted by U t",
-    evaluate};
+    evaluate,
+    scalar_params, sizeof scalar_params / sizeof scalar_params[0]};
 
 /* ---- volumeFlux: the flow rate through cross-sections of a channel ------
  * Continuity says every cross-section of a channel carries the inflow,
@@ -373,4 +374,5 @@ static int flux_evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *er
 
 const mf_metric mf_metric_volume_flux = {
     "volumeFlux", "flow rate through cross-sections of a channel against the inflow",
-    flux_evaluate};
+    flux_evaluate,
+    flux_params, sizeof flux_params / sizeof flux_params[0]};

@@ -167,4 +167,5 @@ static int evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
 
 const mf_metric mf_metric_surge_front = {"surgeFront",
                                          "dam-break surge front Z(T) against an experiment",
-                                         evaluate};
+                                         evaluate,
+    front_params, sizeof front_params / sizeof front_params[0]};

@@ -35,6 +35,8 @@ typedef struct mf_metric {
     const char *name;
     const char *summary;
     int (*evaluate)(const mf_metric_ctx *ctx, const mf_dict *metric_dict, double *error);
+    const mf_param *params; /* the keys of validation/metric besides `metric` */
+    size_t nparams;
 } mf_metric;
 /* Every metric, and the one named (NULL if none). */
 extern const mf_metric *const mf_metrics[];

@@ -19,7 +19,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "mf_error.h"
 
@@ -550,7 +552,7 @@ static int parse_list(parser *P, lexer *lx, mf_dict *d, const token *open, int d
         return too_deep(open);
     vec items = { 0 };
     token t, brace;
-    const token *peek;
+    const token *peek = NULL;
     char found[128];
     int rc;
     for (;;) {
@@ -662,7 +664,7 @@ static int parse_values(parser *P, lexer *lx, mf_dict *d, const token *key, int 
 static int parse_entry(parser *P, lexer *lx, mf_dict *d, key_index *ix, int depth,
                        const token *key)
 {
-    const token *peek;
+    const token *peek = NULL;
     token brace;
     vec items = { 0 };
     MF_CALL(peek_token(lx, &peek));
@@ -692,79 +694,71 @@ static int parse_entry(parser *P, lexer *lx, mf_dict *d, key_index *ix, int dept
 }
 
 /* Read a whole file into a NUL-terminated buffer (*out, *len). Returns
- * READ_OK, READ_ERRNO with *err set, READ_TOO_BIG past the size limit, or
- * READ_NOMEM. */
-enum { READ_OK = 0, READ_ERRNO, READ_TOO_BIG, READ_NOMEM };
+ * READ_OK, READ_ERRNO with *err set, READ_NOT_REGULAR (*what names the kind
+ * of file), READ_TOO_BIG past the size limit, or READ_NOMEM.
+ *
+ * Only regular files are read, and their size is known before the first
+ * byte is: a FIFO would block forever and /dev/zero never ends. The open
+ * is non-blocking so that opening a FIFO with no writer returns at once. */
+enum { READ_OK = 0, READ_ERRNO, READ_NOT_REGULAR, READ_TOO_BIG, READ_NOMEM };
 
-static int slurp(const char *path, char **out, size_t *len, int *err)
+static const char *file_kind(mode_t mode)
+{
+    if (S_ISDIR(mode)) return "a folder";
+    if (S_ISFIFO(mode)) return "a FIFO (named pipe)";
+    if (S_ISCHR(mode)) return "a character device";
+    if (S_ISBLK(mode)) return "a block device";
+    if (S_ISSOCK(mode)) return "a socket";
+    return "not a regular file";
+}
+
+static int slurp(const char *path, char **out, size_t *len, int *err, const char **what)
 {
     *out = NULL;
     *len = 0;
-    FILE *f = fopen(path, "rb");
-    if (!f) {
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0) {
         *err = errno;
         return READ_ERRNO;
     }
     struct stat st;
-    size_t cap = 1 << 16;
-    if (fstat(fileno(f), &st) == 0) {
-        if (S_ISDIR(st.st_mode)) {
-            fclose(f);
-            *err = EISDIR;
+    if (fstat(fd, &st) != 0) {
+        *err = errno;
+        close(fd);
+        return READ_ERRNO;
+    }
+    if (!S_ISREG(st.st_mode)) {
+        *what = file_kind(st.st_mode);
+        close(fd);
+        return READ_NOT_REGULAR;
+    }
+    if ((uintmax_t)st.st_size > MF_DICT_MAX_FILE_BYTES) {
+        close(fd);
+        return READ_TOO_BIG;
+    }
+    size_t size = (size_t)st.st_size, n = 0;
+    char *buf = malloc(size + 1);
+    if (!buf) {
+        close(fd);
+        return READ_NOMEM;
+    }
+    /* The size stat gave, no more: a file that grows while it is read is
+     * read as it was. */
+    while (n < size) {
+        ssize_t got = read(fd, buf + n, size - n);
+        if (got < 0 && errno == EINTR)
+            continue;
+        if (got < 0) {
+            *err = errno;
+            free(buf);
+            close(fd);
             return READ_ERRNO;
         }
-        if (S_ISREG(st.st_mode)) {
-            if ((uintmax_t)st.st_size > MF_DICT_MAX_FILE_BYTES) {
-                fclose(f);
-                return READ_TOO_BIG;
-            }
-            cap = (size_t)st.st_size + 1;
-        }
+        if (got == 0)
+            break; /* shrank meanwhile: what is there */
+        n += (size_t)got;
     }
-    char *buf = malloc(cap);
-    size_t n = 0;
-    int status = buf ? READ_OK : READ_NOMEM;
-    while (status == READ_OK) {
-        size_t got = fread(buf + n, 1, cap - 1 - n, f);
-        n += got;
-        if (n + 1 < cap) { /* a short read: end of file or an error */
-            if (ferror(f)) {
-                *err = errno ? errno : EIO;
-                status = READ_ERRNO;
-            }
-            break;
-        }
-        /* Full: at the end, unless the file grew or is a pipe. Probe one
-         * byte before doubling, so that a file of known size is read into
-         * a buffer of its size. */
-        int c = fgetc(f);
-        if (c == EOF) {
-            if (ferror(f)) {
-                *err = errno ? errno : EIO;
-                status = READ_ERRNO;
-            }
-            break;
-        }
-        if (n + 1 > MF_DICT_MAX_FILE_BYTES) {
-            status = READ_TOO_BIG;
-            break;
-        }
-        char *grown = realloc(buf, 2 * cap);
-        if (!grown) {
-            status = READ_NOMEM;
-            break;
-        }
-        buf = grown;
-        cap *= 2;
-        buf[n++] = (char)c;
-    }
-    fclose(f);
-    if (status == READ_OK && n > MF_DICT_MAX_FILE_BYTES)
-        status = READ_TOO_BIG;
-    if (status != READ_OK) {
-        free(buf);
-        return status;
-    }
+    close(fd);
     buf[n] = '\0';
     *out = buf;
     *len = n;
@@ -810,11 +804,17 @@ static int include_file(parser *P, const lexer *lx, mf_dict *d, key_index *ix, i
             goto done;
         }
     }
-    switch (slurp(path, &buf, &len, &err)) {
+    const char *kind = NULL;
+    switch (slurp(path, &buf, &len, &err, &kind)) {
     case READ_OK: break;
     case READ_ERRNO:
         rc = syntax_error(dir->loc, "cannot open #include file \"%.*s\" (%s)", nl, name->text,
                           strerror(err));
+        goto done;
+    case READ_NOT_REGULAR:
+        rc = syntax_error(dir->loc, "#include file \"%.*s\" is %s, not a regular file: not a "
+                                    "dictionary",
+                          nl, name->text, kind);
         goto done;
     case READ_TOO_BIG:
         rc = syntax_error(dir->loc, "#include file \"%.*s\" is larger than 1 GiB: not a "
@@ -941,10 +941,14 @@ int mf_dict_parse_file(const char *path, mf_dict **out)
     char *buf;
     size_t len;
     int err = 0;
-    switch (slurp(path, &buf, &len, &err)) {
+    const char *kind = NULL;
+    switch (slurp(path, &buf, &len, &err, &kind)) {
     case READ_OK: break;
     case READ_ERRNO:
         return MF_ERROR(MF_ERR_IO, "cannot open dictionary file '%s' (%s)", path, strerror(err));
+    case READ_NOT_REGULAR:
+        return MF_ERROR(MF_ERR_INPUT, "%s: is %s, not a regular file: not a dictionary", path,
+                        kind);
     case READ_TOO_BIG:
         return MF_ERROR(MF_ERR_INPUT, "%s: file is larger than 1 GiB: not a dictionary", path);
     default: return out_of_memory(path);

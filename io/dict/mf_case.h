@@ -29,6 +29,7 @@ typedef struct mf_control {
     const char *writer;  /* writer module name */
     const char *start_from; /* startTime | latestTime */
     long max_retries;    /* retries of a failed step with a smaller dt */
+    double max_memory;   /* GB a scene may need (0: 80% of the machine's memory) */
     /* Run control (issue 15). */
     const char *stop_at; /* endTime | writeNow | noWriteNow | nextWrite */
     bool run_time_modifiable;
@@ -58,5 +59,10 @@ int mf_case_write_resolved(const mf_case *c);
 
 extern const mf_param mf_control_params[];
 extern const size_t mf_control_nparams;
+/* The controlDict table's entry of a key (NULL if none). */
+const mf_param *mf_case_control_param(const char *name);
+/* An endTime from elsewhere (-endTime, compare, stability): in endTime's
+ * range and after startTime; source names it in the message. */
+int mf_case_check_end_time(const mf_control *c, double end_time, const char *source);
 
 #endif

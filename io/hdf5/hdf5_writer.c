@@ -1,15 +1,22 @@
 /* hdf5_writer.c: write one snapshot file (layout in mf_hdf5.h).
  *
- * The file is written as "<path>.tmp", closed, synced and renamed: the real
- * name only ever holds a complete file. Particles are grouped by kind in
- * storage order; StorageIndex records where each came from.
+ * On one rank the file is built in memory, written as "<path>.tmp" (by us,
+ * not HDF5: build_image), synced and renamed: the real name only ever holds a
+ * complete file, and a write that fails (a full disk) leaves no HDF5 handle
+ * open. Particles are grouped by kind in storage order; StorageIndex
+ * records where each came from.
  *
  * On several ranks (a -parallel run) the file is the same one file, written
- * collectively through MPI-IO (parallel HDF5): every rank writes its owned
- * particles of each kind as one block of rows, blocks in rank order (the
- * global storage order: rank 0's particles, then rank 1's, ...), so readers
- * see one snapshot as from a serial run, with each particle's id. The
- * header carries the totals; rank 0 commits the finished file. */
+ * collectively through MPI-IO (parallel HDF5: write_collective): every rank
+ * writes its owned particles of each kind as one block of rows, blocks in
+ * rank order (the global storage order: rank 0's particles, then rank 1's,
+ * ...), so readers see one snapshot as from a serial run, with each
+ * particle's id. The header carries the totals; rank 0 commits the finished
+ * file. A disk that fills while HDF5 flushes the file fails its close there
+ * (said, the .tmp removed); the in-memory path's guarantee that nothing of
+ * HDF5 stays open after such a failure holds on one rank only. */
+#include <errno.h>
+#include <fcntl.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -272,28 +279,104 @@ static int check_particles(const mf_sim *sim, const char *path, int64_t counts[M
     return 0;
 }
 
-static int write_file(snap_writer *w, const char *tmp, const mf_sim *sim,
-                      const mf_dict *params, const int64_t counts[MF_NKINDS])
+/* Close whatever is still open in the file (a group or dataset a failed
+ * call left), then the file: nothing of it may outlive the call, or HDF5
+ * closes it again at exit (inside MPI_Finalize) and crashes there. */
+static void close_all(hid_t *file)
+{
+    if (*file < 0)
+        return;
+    ssize_t n = H5Fget_obj_count(*file, H5F_OBJ_DATASET | H5F_OBJ_GROUP | H5F_OBJ_DATATYPE |
+                                            H5F_OBJ_ATTR | H5F_OBJ_LOCAL);
+    if (n > 0) {
+        hid_t *ids = malloc((size_t)n * sizeof *ids);
+        ssize_t got = ids ? H5Fget_obj_ids(*file, H5F_OBJ_DATASET | H5F_OBJ_GROUP |
+                                                      H5F_OBJ_DATATYPE | H5F_OBJ_ATTR |
+                                                      H5F_OBJ_LOCAL,
+                                           (size_t)n, ids)
+                          : 0;
+        for (ssize_t k = 0; k < got; k++)
+            mf_h5_close(&ids[k]);
+        free(ids);
+    }
+    mf_h5_close(file);
+}
+
+/* The header, the parameters and every kind's datasets into w->file. */
+static int write_contents(snap_writer *w, const mf_sim *sim, const mf_dict *params,
+                          const int64_t counts[MF_NKINDS])
+{
+    MF_CALL(write_header(w, sim, counts));
+    if (params)
+        MF_CALL(write_parameters(w, params));
+    for (int kind = 0; kind < MF_NKINDS; kind++)
+        if (counts[kind] > 0) {
+            w->rows = (hsize_t)counts[kind];
+            MF_CALL(write_kind(w, kind));
+        }
+    return 0;
+}
+
+/* One rank: the snapshot is built in memory (HDF5's core driver, no
+ * backing store) and written to the file by us in one go: HDF5 itself never
+ * writes to the disk, so a full disk (or any write error) is a failed
+ * write() of ours, reported with its errno, after which nothing of HDF5 is
+ * left open. With HDF5 writing the file itself, a failure while it flushed
+ * left the file open inside the library, and closing it at exit crashed.
+ * The cost is the file's image in memory while it is written (twice:
+ * HDF5's and the copy). */
+static int build_image(snap_writer *w, const mf_sim *sim, const mf_dict *params,
+                       const int64_t counts[MF_NKINDS], void **image, size_t *size)
 {
     char detail[256];
+    *image = NULL;
+    *size = 0;
     hid_t fapl = mf_h5_fapl();
-    if (fapl >= 0 && w->par && H5Pset_fapl_mpio(fapl, mf_parallel_comm(w->par), MPI_INFO_NULL) < 0)
+    if (fapl >= 0 && H5Pset_fapl_core(fapl, (size_t)1 << 20, 0) < 0)
         mf_h5_close(&fapl);
-    w->file = fapl < 0 ? H5I_INVALID_HID : H5Fcreate(tmp, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+    w->file = fapl < 0 ? H5I_INVALID_HID : H5Fcreate(w->path, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
     /* Take the message before any other HDF5 call clears the error stack. */
     mf_h5_error_detail(detail, sizeof detail);
     mf_h5_close(&fapl);
     if (w->file < 0)
-        return MF_ERROR(MF_ERR_IO, "cannot create %s (%s)", tmp, detail);
+        return MF_ERROR(MF_ERR_IO, "cannot create %s in memory (%s)", w->path, detail);
     int rc = 0;
-    MF_CALL_GOTO(rc, write_header(w, sim, counts), fail);
-    if (params)
-        MF_CALL_GOTO(rc, write_parameters(w, params), fail);
-    for (int kind = 0; kind < MF_NKINDS; kind++)
-        if (counts[kind] > 0) {
-            w->rows = (hsize_t)counts[kind];
-            MF_CALL_GOTO(rc, write_kind(w, kind), fail);
-        }
+    MF_CALL_GOTO(rc, write_contents(w, sim, params, counts), done);
+    /* Flushed first: the image must hold the metadata still in HDF5's caches. */
+    ssize_t n = H5Fflush(w->file, H5F_SCOPE_GLOBAL) < 0 ? -1 : H5Fget_file_image(w->file, NULL, 0);
+    if (n > 0 && (*image = malloc((size_t)n)) != NULL && H5Fget_file_image(w->file, *image, (size_t)n) == n) {
+        *size = (size_t)n;
+    } else {
+        rc = n > 0 && !*image ? MF_ERROR(MF_ERR_MEMORY, "%s: out of memory for its %zd bytes", w->path, n)
+                              : MF_ERROR(MF_ERR_IO, "cannot finish %s in memory (%s)", w->path,
+                                         mf_h5_error_detail(detail, sizeof detail));
+        free(*image);
+        *image = NULL;
+    }
+done:
+    close_all(&w->file);
+    return rc;
+}
+
+/* Several ranks: tmp written by all of them through MPI-IO, each its block
+ * of rows (collective calls throughout). */
+static int write_collective(snap_writer *w, const char *tmp, const mf_sim *sim,
+                            const mf_dict *params, const int64_t counts[MF_NKINDS])
+{
+    char detail[256];
+    hid_t fapl = mf_h5_fapl();
+    if (fapl >= 0 && H5Pset_fapl_mpio(fapl, mf_parallel_comm(w->par), MPI_INFO_NULL) < 0)
+        mf_h5_close(&fapl);
+    w->file = fapl < 0 ? H5I_INVALID_HID : H5Fcreate(tmp, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+    mf_h5_error_detail(detail, sizeof detail);
+    mf_h5_close(&fapl);
+    if (w->file < 0)
+        return MF_ERROR(MF_ERR_IO, "cannot create %s (%s)", tmp, detail);
+    int rc = write_contents(w, sim, params, counts);
+    if (rc != 0) {
+        close_all(&w->file);
+        return mf_error_trace(rc, __FILE__, __LINE__, __func__);
+    }
     /* Closing flushes: a full disk shows up here. */
     herr_t closed = H5Fclose(w->file);
     w->file = H5I_INVALID_HID;
@@ -301,9 +384,39 @@ static int write_file(snap_writer *w, const char *tmp, const mf_sim *sim,
         return MF_ERROR(MF_ERR_IO, "cannot finish writing %s (%s)", tmp,
                         mf_h5_error_detail(detail, sizeof detail));
     return 0;
-fail:
-    mf_h5_close(&w->file);
-    return rc;
+}
+
+/* size bytes to tmp, synced: a short write or a failed sync removes tmp. */
+static int write_image(const char *tmp, const void *image, size_t size)
+{
+    int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+    if (fd < 0)
+        return MF_ERROR(MF_ERR_IO, "cannot create %s (%s, errno %d)", tmp, strerror(errno), errno);
+    size_t done = 0;
+    int err = 0;
+    while (done < size && !err) {
+        ssize_t put = write(fd, (const char *)image + done, size - done);
+        if (put < 0 && errno == EINTR)
+            continue;
+        if (put <= 0)
+            err = put < 0 ? errno : ENOSPC;
+        else
+            done += (size_t)put;
+    }
+    if (!err && fsync(fd) != 0 && errno != EINVAL)
+        err = errno;
+    if (close(fd) != 0 && !err)
+        err = errno;
+    if (!err)
+        return 0;
+    unlink(tmp);
+    return MF_ERROR(MF_ERR_IO,
+                    "cannot write %s: %s (errno %d) after %zu of %zu bytes; it is removed, the "
+                    "snapshots written before are whole%s",
+                    tmp, strerror(err), err, done, size,
+                    err == ENOSPC || err == EDQUOT ? ": free space on that disk and restart "
+                                                     "with -latestTime"
+                                                   : "");
 }
 
 int mf_hdf5_write_snapshot(const char *path, const mf_sim *sim, const mf_dict *params,
@@ -340,10 +453,16 @@ int mf_hdf5_write_snapshot(const char *path, const mf_sim *sim, const mf_dict *p
 
     mf_h5_quiet quiet;
     mf_h5_quiet_begin(&quiet);
-    rc = write_file(&w, tmp, sim, params, counts);
+    void *image = NULL;
+    size_t size = 0;
+    rc = sim->par ? write_collective(&w, tmp, sim, params, counts)
+                  : build_image(&w, sim, params, counts, &image, &size);
     mf_h5_quiet_end(&quiet);
     free(w.index);
     free(w.buf);
+    if (rc == 0 && !sim->par)
+        rc = write_image(tmp, image, size);
+    free(image);
     /* Every rank has closed the file (a collective close) before rank 0
      * renames it. */
     rc = mf_parallel_agree(sim->par, rc);

@@ -5,9 +5,11 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <errno.h>
+#include <inttypes.h>
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 
 #include "mf_error.h"
@@ -17,6 +19,8 @@
 static int add_mesh(mf_trimesh *out, const struct aiMesh *am, const struct aiMatrix4x4 *t)
 {
     size_t base = out->nverts;
+    if ((am->mNumVertices && !am->mVertices) || (am->mNumFaces && !am->mFaces))
+        return MF_ERROR(MF_ERR_INPUT, "%s: a mesh without its vertex or face arrays", out->name);
     MF_CALL(mf_trimesh_reserve(out, base + am->mNumVertices, out->ntris + am->mNumFaces));
     for (unsigned v = 0; v < am->mNumVertices; v++) {
         const struct aiVector3D *p = &am->mVertices[v];
@@ -33,13 +37,22 @@ static int add_mesh(mf_trimesh *out, const struct aiMesh *am, const struct aiMat
     }
     for (unsigned f = 0; f < am->mNumFaces; f++) {
         const struct aiFace *face = &am->mFaces[f];
-        if (face->mNumIndices != 3) { /* points and lines (polygons are triangulated) */
+        if (face->mNumIndices && !face->mIndices)
+            return MF_ERROR(MF_ERR_INPUT, "%s: face %u has no indices", out->name, f);
+        if (face->mNumIndices < 3) { /* points and lines */
             out->dropped++;
             continue;
         }
-        MF_CALL(mf_trimesh_add_triangle(out, (int32_t)(base + face->mIndices[0]),
-                                        (int32_t)(base + face->mIndices[1]),
-                                        (int32_t)(base + face->mIndices[2])));
+        for (unsigned k = 0; k < face->mNumIndices; k++)
+            if (face->mIndices[k] >= am->mNumVertices)
+                return MF_ERROR(MF_ERR_INPUT, "%s: face %u names vertex %u of %u", out->name, f,
+                                face->mIndices[k] + 1, am->mNumVertices);
+        /* A polygon as a fan of triangles from its first corner: the faces of
+         * the files we read (quads, convex polygons) are split exactly. */
+        for (unsigned k = 1; k + 1 < face->mNumIndices; k++)
+            MF_CALL(mf_trimesh_add_triangle(out, (int32_t)(base + face->mIndices[0]),
+                                            (int32_t)(base + face->mIndices[k]),
+                                            (int32_t)(base + face->mIndices[k + 1])));
     }
     return 0;
 }
@@ -66,12 +79,36 @@ static int add_node(mf_trimesh *out, const struct aiScene *sc, const struct aiNo
         return MF_ERROR(MF_ERR_INPUT, "%s: scene graph nested more than 64 deep", out->name);
     struct aiMatrix4x4 t;
     mat_mul(parent, &node->mTransformation, &t);
+    if ((node->mNumMeshes && !node->mMeshes) || (node->mNumChildren && !node->mChildren))
+        return MF_ERROR(MF_ERR_INPUT, "%s: a scene node without its arrays", out->name);
     for (unsigned k = 0; k < node->mNumMeshes; k++)
-        if (node->mMeshes[k] < sc->mNumMeshes)
+        if (node->mMeshes[k] < sc->mNumMeshes && sc->mMeshes && sc->mMeshes[node->mMeshes[k]])
             MF_CALL(add_mesh(out, sc->mMeshes[node->mMeshes[k]], &t));
     for (unsigned k = 0; k < node->mNumChildren; k++)
-        MF_CALL(add_node(out, sc, node->mChildren[k], &t, depth + 1));
+        if (node->mChildren[k])
+            MF_CALL(add_node(out, sc, node->mChildren[k], &t, depth + 1));
     return 0;
+}
+
+/* The formats read: assimp reads dozens, and some of its readers crash on a
+ * broken file (its OFF reader read out of bounds on a face list longer than
+ * the file, found by fuzzing, and that inside the library, where no check of
+ * ours can reach). These three are what polygon geometry for a scene comes
+ * in, and the fuzz_mesh harness tries them. */
+static const char *const formats[] = {"obj", "stl", "ply"};
+
+static int check_format(const char *path)
+{
+    const char *dot = strrchr(path, '.');
+    const char *slash = strrchr(path, '/');
+    if (dot && (!slash || dot > slash))
+        for (size_t k = 0; k < sizeof formats / sizeof formats[0]; k++)
+            if (strcasecmp(dot + 1, formats[k]) == 0)
+                return 0;
+    return MF_ERROR(MF_ERR_INPUT,
+                    "%s: not a polygon format read here (the name must end in .obj, .stl or "
+                    ".ply; convert the file, e.g. with meshlab or Blender)",
+                    path);
 }
 
 int mf_mesh_import(const char *path, mf_trimesh *out)
@@ -79,16 +116,29 @@ int mf_mesh_import(const char *path, mf_trimesh *out)
     size_t len = strlen(path) < sizeof out->name - 1 ? strlen(path) : sizeof out->name - 1;
     memcpy(out->name, path, len);
     out->name[len] = '\0';
+    MF_CALL(check_format(path));
     struct stat st;
     if (stat(path, &st) != 0)
         return MF_ERROR(MF_ERR_IO, "%s: cannot open (%s)", path, strerror(errno));
+    /* Only regular files, of a size known before assimp reads a byte: a FIFO
+     * would block, a device never end. */
     if (!S_ISREG(st.st_mode))
-        return MF_ERROR(MF_ERR_IO, "%s: not a regular file", path);
+        return MF_ERROR(MF_ERR_INPUT, "%s: is %s, not a regular file: not a polygon file", path,
+                        S_ISDIR(st.st_mode)    ? "a folder"
+                        : S_ISFIFO(st.st_mode) ? "a FIFO (named pipe)"
+                        : S_ISCHR(st.st_mode)  ? "a character device"
+                                               : "a special file");
     if (st.st_size == 0)
         return MF_ERROR(MF_ERR_INPUT, "%s: the file is empty (0 bytes)", path);
-    const struct aiScene *sc =
-        aiImportFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                               aiProcess_SortByPType);
+    if ((uintmax_t)st.st_size > MF_MESH_MAX_FILE_BYTES)
+        return MF_ERROR(MF_ERR_INPUT, "%s: %jd bytes is more than the %zu GiB a polygon file may "
+                        "have here", path, (intmax_t)st.st_size, MF_MESH_MAX_FILE_BYTES >> 30);
+    /* No post-processing: assimp's own triangulation stops the process (an
+     * assertion) on some broken files (found by fuzzing: an OFF file with a
+     * bad face line). Polygons are split here instead (add_mesh, which also
+     * checks every index), corners merged by mf_trimesh_weld; points and
+     * lines are counted, and refused by the scene builder. */
+    const struct aiScene *sc = aiImportFile(path, 0);
     if (!sc)
         return MF_ERROR(MF_ERR_INPUT, "%s: not a polygon file assimp can read (%s)", path,
                         aiGetErrorString());

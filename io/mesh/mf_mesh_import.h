@@ -1,5 +1,6 @@
-/* mf_mesh_import.h: polygon files (OBJ, STL, PLY, OFF and whatever else
- * Debian's assimp reads) into the plain triangle mesh of core/scene/mf_trimesh.h.
+/* mf_mesh_import.h: polygon files (OBJ, STL and PLY, through Debian's
+ * assimp; other formats are refused: some of assimp's readers crash on
+ * broken files) into the plain triangle mesh of core/scene/mf_trimesh.h.
  *
  * Polygons are split into triangles; points and lines are counted in
  * mesh->dropped and left out; node transforms of formats that have them
@@ -12,7 +13,12 @@
 
 #include "mf_trimesh.h"
 
-/* Read the file at path into *out (initialised by the caller). */
+/* Polygon files larger than this are refused before they are read: 4 GiB
+ * is tens of millions of triangles, beyond what a scene's lattice can use. */
+#define MF_MESH_MAX_FILE_BYTES ((size_t)4 << 30)
+
+/* Read the file at path into *out (initialised by the caller); only a
+ * regular file, of at most MF_MESH_MAX_FILE_BYTES. */
 int mf_mesh_import(const char *path, mf_trimesh *out);
 
 /* The reader the scene builder takes: `file` as written in a case, tried

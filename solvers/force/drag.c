@@ -133,11 +133,6 @@ static int drag_accumulate(void *data, const mf_sim *sim, double *acc)
     return 0;
 }
 
-double mf_drag_radius(const void *data)
-{
-    return ((const drag_data *)data)->re;
-}
-
 const mf_force_ops mf_force_drag = {
     .info = {MF_ABI_VERSION, MF_KIND_FORCE, "drag",
              "drag toward the neighbourhood's mean velocity, a permeable layer (Appendix B)",

@@ -138,6 +138,10 @@ typedef struct st_data {
     double *nrm;               /* outward unit normal of the particle's own fluid; 0: none */
     double *p_surface;         /* freeSurface pressure: sigma kappa near a free surface; NAN */
     size_t p_surface_n;        /* particles p_surface holds (this step's) */
+    /* The last accumulate's curvature and acceleration, for write_fields
+     * (accumulate itself leaves the fields alone: forces are side-effect free). */
+    double *kappa_out, *accel_out;
+    size_t out_n;              /* particles they hold */
 } st_data;
 
 /* ---- curvature from the filled fraction f of the r_st disk (ball) --------- */
@@ -315,6 +319,8 @@ static void st_destroy(void *data)
     free(d->fdir);
     free(d->nrm);
     free(d->p_surface);
+    free(d->kappa_out);
+    free(d->accel_out);
     free(d);
 }
 
@@ -419,7 +425,13 @@ static int reserve(st_data *d, size_t n)
     double *ps = realloc(d->p_surface, cap * sizeof *ps);
     if (ps)
         d->p_surface = ps;
-    if (!n1 || !nall || !k || !ks || !f || !nr || !ps)
+    double *ko = realloc(d->kappa_out, cap * sizeof *ko);
+    if (ko)
+        d->kappa_out = ko;
+    double *ao = realloc(d->accel_out, 3 * cap * sizeof *ao);
+    if (ao)
+        d->accel_out = ao;
+    if (!n1 || !nall || !k || !ks || !f || !nr || !ps || !ko || !ao)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu particles", n);
     d->cap = cap;
     return 0;
@@ -879,11 +891,8 @@ static int st_accumulate(void *data, const mf_sim *sim, double *acc)
 {
     st_data *d = data;
     const mf_particles *p = sim->p;
-    double *kappa_out = mf_particles_fd(p, d->f_curvature);
-    double *accel_out = mf_particles_fd(p, d->f_accel);
-    memset(kappa_out, 0, p->n * sizeof *kappa_out);
-    memset(accel_out, 0, 3 * p->n * sizeof *accel_out);
     d->p_surface_n = 0;
+    d->out_n = 0;
     if (!d->any)
         return 0;
     if (d->pressure_mode && !d->claimed)
@@ -895,6 +904,10 @@ static int st_accumulate(void *data, const mf_sim *sim, double *acc)
     mf_pairs v;
     MF_CALL(mf_neighbours_pairs(sim->neighbours, p, d->pairs, &v));
     MF_CALL(reserve(d, p->n));
+    double *kappa_out = d->kappa_out, *accel_out = d->accel_out;
+    memset(kappa_out, 0, p->n * sizeof *kappa_out);
+    memset(accel_out, 0, 3 * p->n * sizeof *accel_out);
+    d->out_n = p->n;
     int ff = mf_particles_field_index(p, "FluidId");
     st_ctx c = {.d = d, .p = p, .fid = ff >= 0 ? mf_particles_fi(p, ff) : NULL, .v = &v,
                 .acc = acc, .accel_out = accel_out, .kappa_out = kappa_out, .sim = sim};
@@ -944,10 +957,28 @@ static int st_accumulate(void *data, const mf_sim *sim, double *acc)
     return 0;
 }
 
+/* The Curvature and SurfaceTension fields from the last accumulate. */
+static int st_write_fields(void *data, mf_sim *sim)
+{
+    const st_data *d = data;
+    const mf_particles *p = sim->p;
+    double *kappa = mf_particles_fd(p, d->f_curvature);
+    double *accel = mf_particles_fd(p, d->f_accel);
+    const size_t n = d->out_n <= p->n ? d->out_n : 0;
+    if (n)
+        memcpy(kappa, d->kappa_out, n * sizeof *kappa);
+    if (n)
+        memcpy(accel, d->accel_out, 3 * n * sizeof *accel);
+    memset(kappa + n, 0, (p->n - n) * sizeof *kappa);
+    memset(accel + 3 * n, 0, 3 * (p->n - n) * sizeof *accel);
+    return 0;
+}
+
 /* Brackbill et al. (1992): a capillary wave must not cross a particle in a
  * step, dt <= sqrt(rho_bar l0^3 / (2 pi sigma)). */
-static double st_stable_dt(const st_data *d, const mf_sim *sim)
+static int st_stable_dt(void *data, const mf_sim *sim, double *out)
 {
+    const st_data *d = data;
     double dt = INFINITY;
     for (int x = 0; x < d->nfluids; x++)
         for (int y = x; y < d->nfluids; y++) {
@@ -959,63 +990,30 @@ static double st_stable_dt(const st_data *d, const mf_sim *sim)
             if (lim < dt)
                 dt = lim;
         }
-    return dt;
+    *out = dt;
+    return 0;
 }
 
-double mf_forces_stable_dt(const mf_sim *sim)
+static bool st_claim_surface_pressure(void *data)
 {
-    double dt = INFINITY;
-    for (size_t k = 0; k < sim->nforces; k++)
-        if (sim->forces[k].info == &mf_force_surfaceTension.info && sim->forces[k].data) {
-            double lim = st_stable_dt(sim->forces[k].data, sim);
-            if (lim < dt)
-                dt = lim;
-        }
-    return dt;
+    st_data *d = data;
+    if (!(d->pressure_mode && d->any))
+        return false;
+    d->claimed = true;
+    return true;
 }
 
-double mf_forces_radius(const mf_sim *sim)
+static int st_surface_pressure(void *data, const mf_sim *sim, const uint8_t *dirichlet,
+                               double *p)
 {
-    double r = 0;
-    for (size_t k = 0; k < sim->nforces; k++)
-        if (sim->forces[k].info == &mf_force_surfaceTension.info && sim->forces[k].data) {
-            const st_data *d = sim->forces[k].data;
-            r = fmax(r, d->r);
-        } else if (sim->forces[k].info == &mf_force_drag.info && sim->forces[k].data) {
-            r = fmax(r, mf_drag_radius(sim->forces[k].data));
-        }
-    return r;
-}
-
-bool mf_forces_claim_surface_pressure(mf_sim *sim)
-{
-    bool any = false;
-    for (size_t k = 0; k < sim->nforces; k++)
-        if (sim->forces[k].info == &mf_force_surfaceTension.info && sim->forces[k].data) {
-            st_data *d = sim->forces[k].data;
-            if (d->pressure_mode && d->any) {
-                d->claimed = true;
-                any = true;
-            }
-        }
-    return any;
-}
-
-void mf_forces_surface_pressure(const mf_sim *sim, const uint8_t *dirichlet, double *p)
-{
+    const st_data *d = data;
     const mf_particles *ps = sim->p;
-    for (size_t i = 0; i < ps->n; i++)
-        p[i] = 0;
-    for (size_t k = 0; k < sim->nforces; k++) {
-        if (sim->forces[k].info != &mf_force_surfaceTension.info || !sim->forces[k].data)
-            continue;
-        const st_data *d = sim->forces[k].data;
-        if (!d->pressure_mode)
-            continue;
-        for (size_t i = 0; i < d->p_surface_n && i < ps->n_owned; i++)
-            if (dirichlet[i] && ps->kind[i] == MF_FLUID && !isnan(d->p_surface[i]))
-                p[i] += d->p_surface[i];
-    }
+    if (!d->pressure_mode)
+        return 0;
+    for (size_t i = 0; i < d->p_surface_n && i < ps->n_owned; i++)
+        if (dirichlet[i] && ps->kind[i] == MF_FLUID && !isnan(d->p_surface[i]))
+            p[i] += d->p_surface[i];
+    return 0;
 }
 
 const mf_force_ops mf_force_surfaceTension = {
@@ -1026,4 +1024,9 @@ const mf_force_ops mf_force_surfaceTension = {
     .create = st_create,
     .accumulate = st_accumulate,
     .destroy = st_destroy,
+    .flags = MF_FORCE_INTERNAL,
+    .stable_dt = st_stable_dt,
+    .write_fields = st_write_fields,
+    .claim_surface_pressure = st_claim_surface_pressure,
+    .surface_pressure = st_surface_pressure,
 };

@@ -19,6 +19,7 @@
 #include <mpi.h>
 
 #include "mf_error.h"
+#include "mf_hash.h"
 
 /* Largest values hypre's index types hold in this build (Debian's 2.26:
  * both 32-bit). */
@@ -264,15 +265,24 @@ out:
 /* Copy the CSR, b and x into hypre IJ objects. The matrix goes in with ONE
  * HYPRE_IJMatrixSetValues call for all local rows, after telling hypre the
  * exact diagonal-block / off-diagonal-block counts of every row, so it
- * allocates once and never needs its auxiliary (row-by-row) structure. */
-static int assemble(const char *who, const mf_csr *A, const double *b, const double *x,
-                    hypre_system *sys)
+ * allocates once and never needs its auxiliary (row-by-row) structure.
+ *
+ * With rows (slot space, one rank): hypre's row slot[r] holds row r, its
+ * columns mapped through slot too, and every slot no row names holds the
+ * decoupled row d x = 0 (d: the mean diagonal of the rows, so that a
+ * smoother set up while the slot was one of them keeps its scale). The
+ * list of hypre rows is the rows' slots in row order, then the free slots;
+ * sys->rows[0, nrows) are where x comes back from. */
+static int assemble(const char *who, const mf_csr *A, const mf_row_names *rows, const double *b,
+                    const double *x, hypre_system *sys)
 {
-    const HYPRE_Int n = (HYPRE_Int)A->nrows;
-    const HYPRE_BigInt ilower = (HYPRE_BigInt)A->row_offset;
+    const HYPRE_Int nrows = (HYPRE_Int)A->nrows;
+    const HYPRE_Int n = rows ? (HYPRE_Int)rows->nslots : nrows; /* hypre's local rows */
+    const HYPRE_BigInt ilower = rows ? 0 : (HYPRE_BigInt)A->row_offset;
     const HYPRE_BigInt iupper = ilower + n - 1; /* ilower - 1 on a rank with no rows */
-    const size_t k0 = n > 0 ? A->rowptr[0] : 0;
-    const size_t nnz = n > 0 ? A->rowptr[n] - k0 : 0;
+    const size_t k0 = nrows > 0 ? A->rowptr[0] : 0;
+    const size_t nnz_rows = nrows > 0 ? A->rowptr[nrows] - k0 : 0;
+    const size_t nnz = nnz_rows + (size_t)(n - nrows); /* + one per free slot */
     int rc = 0;
     void *obj = NULL;
 
@@ -282,28 +292,69 @@ static int assemble(const char *who, const mf_csr *A, const double *b, const dou
     HYPRE_Int *diag_sizes = malloc(((size_t)n + 1) * sizeof *diag_sizes);
     HYPRE_Int *offd_sizes = malloc(((size_t)n + 1) * sizeof *offd_sizes);
     HYPRE_BigInt *cols = malloc((nnz + 1) * sizeof *cols);
+    /* The free slots' values (the rows' own go in from A->val). */
+    double *vals = rows ? malloc(((size_t)(n - nrows) + 1) * sizeof *vals) : NULL;
+    double *bx = rows ? malloc(((size_t)n + 1) * sizeof *bx) : NULL;
+    uint8_t *used = rows ? calloc((size_t)n + 1, 1) : NULL;
     sys->rows = malloc(((size_t)n + 1) * sizeof *sys->rows);
     if (ncols == NULL || diag_sizes == NULL || offd_sizes == NULL || cols == NULL ||
-        sys->rows == NULL)
+        sys->rows == NULL || (rows && (vals == NULL || bx == NULL || used == NULL)))
         rc = MF_ERROR(MF_ERR_MEMORY, "%s: out of memory copying %zu non-zeros for hypre", who,
                       nnz);
     MF_CALL_GOTO(rc, mf_hypre_agree(who, rc), out);
 
-    /* Global columns were checked against nglobal, which fits HYPRE_BigInt. */
-    for (HYPRE_Int i = 0; i < n; i++) {
-        HYPRE_Int ndiag = 0, noffd = 0;
-        sys->rows[i] = ilower + i;
-        for (size_t k = A->rowptr[i]; k < A->rowptr[i + 1]; k++) {
-            HYPRE_BigInt c = (HYPRE_BigInt)A->col[k];
-            cols[k - k0] = c;
-            if (c >= ilower && c <= iupper)
-                ndiag++;
-            else
-                noffd++;
+    if (!rows) {
+        /* Global columns were checked against nglobal, which fits HYPRE_BigInt. */
+        for (HYPRE_Int i = 0; i < n; i++) {
+            HYPRE_Int ndiag = 0, noffd = 0;
+            sys->rows[i] = ilower + i;
+            for (size_t k = A->rowptr[i]; k < A->rowptr[i + 1]; k++) {
+                HYPRE_BigInt c = (HYPRE_BigInt)A->col[k];
+                cols[k - k0] = c;
+                if (c >= ilower && c <= iupper)
+                    ndiag++;
+                else
+                    noffd++;
+            }
+            ncols[i] = ndiag + noffd;
+            diag_sizes[i] = ndiag;
+            offd_sizes[i] = noffd;
         }
-        ncols[i] = ndiag + noffd;
-        diag_sizes[i] = ndiag;
-        offd_sizes[i] = noffd;
+    } else {
+        double dsum = 0;
+        for (HYPRE_Int i = 0; i < nrows; i++) {
+            const int64_t s = rows->slot[i];
+            if (s < 0 || s >= rows->nslots || used[s]) {
+                rc = MF_ERROR(MF_ERR_INPUT, "%s: row %d names slot %" PRId64 ", %s", who, (int)i,
+                              s, s < 0 || s >= rows->nslots ? "outside [0, nslots)"
+                                                            : "named by another row too");
+                goto out;
+            }
+            used[s] = 1;
+            sys->rows[i] = (HYPRE_BigInt)s;
+            ncols[i] = (HYPRE_Int)(A->rowptr[i + 1] - A->rowptr[i]);
+            diag_sizes[s] = ncols[i];
+            for (size_t k = A->rowptr[i]; k < A->rowptr[i + 1]; k++) {
+                cols[k - k0] = (HYPRE_BigInt)rows->slot[A->col[k] - A->row_offset];
+                if (A->col[k] == A->row_offset + i)
+                    dsum += fabs(A->val[k]);
+            }
+            bx[i] = b[i];
+        }
+        const double d = nrows > 0 && dsum > 0 ? dsum / nrows : 1.0;
+        HYPRE_Int next = nrows;
+        size_t k = nnz_rows;
+        for (HYPRE_Int s = 0; s < n; s++)
+            if (!used[s]) {
+                sys->rows[next] = s;
+                ncols[next] = 1;
+                diag_sizes[s] = 1;
+                cols[k] = s;
+                vals[k++ - nnz_rows] = d;
+                bx[next++] = 0.0;
+            }
+        for (HYPRE_Int s = 0; s < n; s++)
+            offd_sizes[s] = 0;
     }
 
     MF_HYPRE_CALL(who, rc, out, HYPRE_IJMatrixCreate,
@@ -312,21 +363,34 @@ static int assemble(const char *who, const mf_csr *A, const double *b, const dou
     MF_HYPRE_CALL(who, rc, out, HYPRE_IJMatrixSetPrintLevel, (sys->A, 0));
     MF_HYPRE_CALL(who, rc, out, HYPRE_IJMatrixSetDiagOffdSizes, (sys->A, diag_sizes, offd_sizes));
     MF_HYPRE_CALL(who, rc, out, HYPRE_IJMatrixInitialize, (sys->A));
+    /* The rows (their values as the caller has them), then the free slots. */
     MF_HYPRE_CALL(who, rc, out, HYPRE_IJMatrixSetValues,
-                  (sys->A, n, ncols, sys->rows, cols, n > 0 ? A->val + k0 : NULL));
+                  (sys->A, nrows, ncols, sys->rows, cols, nrows > 0 ? A->val + k0 : NULL));
+    if (n > nrows)
+        MF_HYPRE_CALL(who, rc, out, HYPRE_IJMatrixSetValues,
+                      (sys->A, n - nrows, ncols + nrows, sys->rows + nrows, cols + nnz_rows,
+                       vals));
     MF_HYPRE_CALL(who, rc, out, HYPRE_IJMatrixAssemble, (sys->A));
     MF_HYPRE_CALL(who, rc, out, HYPRE_IJMatrixGetObject, (sys->A, &obj));
     sys->parA = (HYPRE_ParCSRMatrix)obj;
 
-    MF_CALL_GOTO(rc, assemble_vector(who, ilower, iupper, n, sys->rows, b, &sys->b, &sys->parb),
+    MF_CALL_GOTO(rc, assemble_vector(who, ilower, iupper, n, sys->rows, rows ? bx : b, &sys->b,
+                                     &sys->parb),
                  out);
-    MF_CALL_GOTO(rc, assemble_vector(who, ilower, iupper, n, sys->rows, x, &sys->x, &sys->parx),
+    if (rows)
+        for (HYPRE_Int i = 0; i < nrows; i++)
+            bx[i] = x[i]; /* the free slots keep 0 */
+    MF_CALL_GOTO(rc, assemble_vector(who, ilower, iupper, n, sys->rows, rows ? bx : x, &sys->x,
+                                     &sys->parx),
                  out);
 out:
     free(ncols);
     free(diag_sizes);
     free(offd_sizes);
     free(cols);
+    free(vals);
+    free(bx);
+    free(used);
     if (rc != 0)
         system_free(sys);
     return rc;
@@ -334,31 +398,19 @@ out:
 
 /* ---- pattern fingerprint (for reusing an AMG hierarchy) ------------------ */
 
-/* One 64-bit word into the running hash: splitmix64's finaliser on the
- * word, then an FNV-style combine (word by word: the pattern of a million
- * rows is 30 million words). */
-static uint64_t hash_word(uint64_t h, uint64_t v)
-{
-    v += 0x9e3779b97f4a7c15ull;
-    v = (v ^ (v >> 30)) * 0xbf58476d1ce4e5b9ull;
-    v = (v ^ (v >> 27)) * 0x94d049bb133111ebull;
-    v ^= v >> 31;
-    return (h ^ v) * 0x100000001b3ull;
-}
-
 int mf_hypre_pattern_hash(const mf_csr *A, uint64_t *hash)
 {
     int rank = 0;
     MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-    uint64_t h = 0xcbf29ce484222325ull;
-    h = hash_word(h, (uint64_t)rank);
-    h = hash_word(h, (uint64_t)A->nglobal);
-    h = hash_word(h, (uint64_t)A->row_offset);
-    h = hash_word(h, (uint64_t)A->nrows);
+    uint64_t h = MF_HASH_START;
+    h = mf_hash_word(h, (uint64_t)rank);
+    h = mf_hash_word(h, (uint64_t)A->nglobal);
+    h = mf_hash_word(h, (uint64_t)A->row_offset);
+    h = mf_hash_word(h, (uint64_t)A->nrows);
     for (size_t i = 0; i < A->nrows; i++) {
-        h = hash_word(h, (uint64_t)(A->rowptr[i + 1] - A->rowptr[i]));
+        h = mf_hash_word(h, (uint64_t)(A->rowptr[i + 1] - A->rowptr[i]));
         for (size_t k = A->rowptr[i]; k < A->rowptr[i + 1]; k++)
-            h = hash_word(h, (uint64_t)A->col[k]);
+            h = mf_hash_word(h, (uint64_t)A->col[k]);
     }
     /* One value on every rank, so all ranks take the same reuse decision. */
     MPI_Allreduce(&h, hash, 1, MPI_UINT64_T, MPI_BXOR, MPI_COMM_WORLD);
@@ -426,8 +478,16 @@ int mf_hypre_pcg_solve(const mf_hypre_pcg *pcg, const mf_csr *A, const double *b
     /* hypre's error flag is global and sticky: start clean so that a failure
      * left by someone else is not reported as ours. */
     HYPRE_ClearAllErrors();
-    MF_CALL_GOTO(rc, assemble(who, A, b, x, &sys), done);
-    rc = pcg->precond_prepare(pcg->ctx, A, &pc);
+    /* Slot space on one rank only (the slots are a rank's own). */
+    const mf_row_names *rows = pcg->rows && lay.nprocs == 1 ? pcg->rows : NULL;
+    if (rows && (rows->nslots < (int64_t)A->nrows || rows->nslots > HYPRE_INT_MAX ||
+                 (A->nrows > 0 && rows->slot == NULL))) {
+        rc = MF_ERROR(MF_ERR_INPUT, "%s: %" PRId64 " slots for %zu rows", who, rows->nslots,
+                      A->nrows);
+        goto done;
+    }
+    MF_CALL_GOTO(rc, assemble(who, A, rows, b, x, &sys), done);
+    rc = pcg->precond_prepare(pcg->ctx, A, rows, &pc);
     prepared = rc == 0;
     MF_CALL_GOTO(rc, mf_hypre_agree(who, rc), done);
 
@@ -474,7 +534,7 @@ done:
     if (solver)
         HYPRE_ParCSRPCGDestroy(solver);
     if (prepared && pcg->precond_release)
-        pcg->precond_release(pcg->ctx, rc == 0 && converged);
+        pcg->precond_release(pcg->ctx, rep, rc == 0 && converged);
     system_free(&sys);
     layout_free(&lay);
     if (rc == 0 && !converged)

@@ -3,21 +3,44 @@
  *
  * The defaults are those that work well for MPS pressure matrices (about
  * 30 non-zeros per row in 3-D): HMIS coarsening, extended+i interpolation
- * truncated to 4 weights per row, l1-scaled symmetric hybrid Gauss-Seidel,
- * one level of aggressive coarsening (measured faster: a cheaper hierarchy
- * outweighs a few more iterations). PCG needs a symmetric positive definite
+ * (in hypre's matrix-matrix form, 17: the same weights as 6, set up in half
+ * the time) truncated to 4 weights per row, hybrid Gauss-Seidel forward on
+ * the way down and backward on the way up (relaxType 3: the V-cycle is
+ * symmetric with half the sweeps of the symmetric smoothers 6 and 8; on
+ * the 2-D and 3-D bench cases a few more iterations, a quarter to a third
+ * fewer instructions in the solve), one level of aggressive coarsening (measured faster when the hierarchy is
+ * built for each solve: a cheaper set-up outweighs a few more iterations;
+ * the MPS solver asks for none in 2-D, where the hierarchy is kept across
+ * steps, mps_module.c). PCG needs a symmetric positive definite
  * preconditioner, hence a symmetric smoother and a fixed cycle (one V-cycle,
  * tolerance 0, so BoomerAMG never stops early or flags non-convergence).
  *
- * reuseSetup > 0 keeps the hierarchy for that many further solves as long
- * as the matrix size and sparsity pattern do not change (the values may:
- * the fine level always uses the new matrix; coarse levels are from the old
- * one). A reused hierarchy that fails to converge is rebuilt and the solve
- * repeated once from the same initial guess.
+ * Keeping a hierarchy. BoomerAMG's solve takes the fine-level matrix it is
+ * given (hypre_BoomerAMGSolve sets A_array[0] = A), so a hierarchy set up
+ * for one matrix preconditions another of the same size: coarse levels and
+ * interpolation are the old matrix's, PCG works on the new one, and the
+ * answer is as accurate as ever (only the iteration count can suffer).
+ *  - reuseHierarchy (default yes): when the caller names the rows (mf_row_names,
+ *    the MPS pressure equation: one slot per particle), the system is
+ *    assembled in slot space (hypre_common.c), so its size and the meaning
+ *    of each row stay fixed while the free surface and the neighbour pairs
+ *    change, and one hierarchy serves step after step. It is rebuilt when
+ *    the slots change meaning (a new epoch: the particles were reordered,
+ *    added or removed) and when a solve took more than rebuildRatio times
+ *    the iterations of the hierarchy's first solve (at least two more).
+ *    Without the rebuild a kept hierarchy ages: on the 2-D bench dam break
+ *    the iterations grow from 5 to 8 over 25 steps and to 49 over 1000
+ *    (docs/incoming/iface.md).
+ *  - reuseSetup > 0 keeps the hierarchy for that many further solves as
+ *    long as the matrix size and sparsity pattern do not change (the
+ *    implicit viscosity: one matrix, a solve per velocity component).
+ * A kept hierarchy that fails to converge is rebuilt and the solve repeated
+ * once from the same initial guess.
  */
 #define MF_PRESSURE_HYPRE_INTERNAL
 #include "pressure_hypre.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -27,10 +50,17 @@ static const char module_name[] = "PCG_BoomerAMG";
 
 typedef struct pcg_boomeramg {
     mf_pcg_boomeramg_settings s;
-    HYPRE_Solver amg;  /* between solves only when reuse_setup > 0 */
-    uint64_t pattern;  /* fingerprint of the matrix amg was set up with */
-    long reuses_left;  /* further solves amg may serve */
+    HYPRE_Solver amg;  /* between solves only when it may serve again */
     bool reused;       /* the current solve reuses amg */
+    /* reuseSetup: the pattern amg was set up with, the solves it may serve. */
+    uint64_t pattern;
+    long reuses_left;
+    /* reuseHierarchy: amg was set up in slot space (nslots, epoch), its
+     * first solve took first_iterations (-1: not yet), the last one last. */
+    bool slot_space;
+    int64_t nslots;
+    uint64_t epoch;
+    int first_iterations, last_iterations;
 } pcg_boomeramg;
 
 #define P(field) offsetof(mf_pcg_boomeramg_settings, field)
@@ -45,15 +75,23 @@ static const mf_param params[] = {
      "levels of aggressive coarsening from the finest (0 = none)"},
     {"coarsenType", MF_PARAM_INT, "10", 0, 22, NULL, P(coarsen_type),
      "hypre coarsening: 10 HMIS, 8 PMIS, 6 Falgout, 0 CLJP, 3 RS (1, 21, 22 also)"},
-    {"interpType", MF_PARAM_INT, "6", 0, 18, NULL, P(interp_type),
-     "hypre interpolation: 6 extended+i, 0 classical, 8 standard, 14 extended"},
+    {"interpType", MF_PARAM_INT, "17", 0, 18, NULL, P(interp_type),
+     "hypre interpolation: 17 extended+i (matrix-matrix form), 6 extended+i, 0 classical, "
+     "8 standard, 14 extended"},
     {"pMaxElmts", MF_PARAM_INT, "4", 0, 100, NULL, P(p_max_elmts),
      "most interpolation weights per row (0 = no limit)"},
-    {"relaxType", MF_PARAM_INT, "8", 0, 18, NULL, P(relax_type),
-     "smoother, symmetric for PCG: 8 l1 symmetric GS, 6 symmetric GS, 0 Jacobi, 16 Chebyshev, "
-     "18 l1 Jacobi"},
+    {"relaxType", MF_PARAM_INT, "3", 0, 18, NULL, P(relax_type),
+     "smoother, a symmetric V-cycle for PCG: 3 hybrid GS forward down, backward up; 13 the same "
+     "l1-scaled; symmetric on each sweep: 8 l1 symmetric GS, 6 symmetric GS, 0 Jacobi, "
+     "16 Chebyshev, 18 l1 Jacobi"},
     {"reuseSetup", MF_PARAM_INT, "0", 0, 1000, NULL, P(reuse_setup),
      "further solves that may reuse the AMG hierarchy while the pattern is unchanged (0 = never)"},
+    {"reuseHierarchy", MF_PARAM_BOOL, "yes", MF_NO_RANGE, NULL, P(reuse_hierarchy),
+     "keep the AMG hierarchy across solves whose rows the caller names (the MPS pressure "
+     "equation), rebuilding it when the rows change meaning or the iterations grow"},
+    {"rebuildRatio", MF_PARAM_SCALAR, "2", 1, 100, NULL, P(rebuild_ratio),
+     "rebuild a kept hierarchy after a solve that took more than this many times the "
+     "iterations of its first solve"},
 };
 #undef P
 
@@ -61,7 +99,7 @@ static int check_settings(const mf_pcg_boomeramg_settings *s)
 {
     static const long coarsen_types[] = {0, 1, 3, 6, 8, 10, 21, 22};
     /* Smoothers that make the V-cycle symmetric when used both down and up. */
-    static const long relax_types[] = {0, 6, 8, 16, 18};
+    static const long relax_types[] = {0, 3, 6, 8, 13, 16, 18};
     bool ok;
 
     MF_CALL(mf_hypre_check_pcg_settings(module_name, s->tolerance, s->max_iter));
@@ -71,6 +109,9 @@ static int check_settings(const mf_pcg_boomeramg_settings *s)
     if (s->aggressive_levels < 0 || s->aggressive_levels > 25)
         return MF_ERROR(MF_ERR_INPUT, "%s: aggressiveLevels %ld is not in [0, 25]", module_name,
                         s->aggressive_levels);
+    if (!(s->rebuild_ratio >= 1 && s->rebuild_ratio <= 100))
+        return MF_ERROR(MF_ERR_INPUT, "%s: rebuildRatio %g is not in [1, 100]", module_name,
+                        s->rebuild_ratio);
     ok = false;
     for (size_t i = 0; i < sizeof coarsen_types / sizeof *coarsen_types; i++)
         ok = ok || s->coarsen_type == coarsen_types[i];
@@ -89,8 +130,8 @@ static int check_settings(const mf_pcg_boomeramg_settings *s)
         ok = ok || s->relax_type == relax_types[i];
     if (!ok)
         return MF_ERROR(MF_ERR_INPUT,
-                        "%s: relaxType %ld is not a symmetric smoother (PCG needs one): use 8, 6, "
-                        "0, 16 or 18",
+                        "%s: relaxType %ld does not make a symmetric V-cycle (PCG needs one): "
+                        "use 3, 13, 8, 6, 0, 16 or 18",
                         module_name, s->relax_type);
     if (s->reuse_setup < 0 || s->reuse_setup > 1000)
         return MF_ERROR(MF_ERR_INPUT, "%s: reuseSetup %ld is not in [0, 1000]", module_name,
@@ -119,6 +160,7 @@ static void discard_hierarchy(pcg_boomeramg *d)
         HYPRE_BoomerAMGDestroy(d->amg);
     d->amg = NULL;
     d->reuses_left = 0;
+    d->slot_space = false;
 }
 
 static int create_amg(const mf_pcg_boomeramg_settings *s, HYPRE_Solver *out)
@@ -135,9 +177,14 @@ static int create_amg(const mf_pcg_boomeramg_settings *s, HYPRE_Solver *out)
     MF_HYPRE_CALL(module_name, rc, fail, HYPRE_BoomerAMGSetPMaxElmts,
                   (amg, (HYPRE_Int)s->p_max_elmts));
     /* Sets the down and up sweeps (the coarsest level keeps Gaussian
-     * elimination); type 8 is symmetric on its own: forward then backward. */
+     * elimination); types 6 and 8 are symmetric on their own (forward then
+     * backward); a forward type 3 or 13 on the way down takes its backward
+     * 4 or 14 on the way up, which makes the cycle symmetric. */
     MF_HYPRE_CALL(module_name, rc, fail, HYPRE_BoomerAMGSetRelaxType,
                   (amg, (HYPRE_Int)s->relax_type));
+    if (s->relax_type == 3 || s->relax_type == 13)
+        MF_HYPRE_CALL(module_name, rc, fail, HYPRE_BoomerAMGSetCycleRelaxType,
+                      (amg, (HYPRE_Int)s->relax_type + 1, 2));
     MF_HYPRE_CALL(module_name, rc, fail, HYPRE_BoomerAMGSetNumSweeps, (amg, 1));
     MF_HYPRE_CALL(module_name, rc, fail, HYPRE_BoomerAMGSetStrongThreshold,
                   (amg, s->strong_threshold));
@@ -166,10 +213,40 @@ static HYPRE_Int keep_hierarchy(HYPRE_Solver amg, HYPRE_ParCSRMatrix A, HYPRE_Pa
     return 0;
 }
 
-static int precond_prepare(void *ctx, const mf_csr *A, mf_hypre_precond *pc)
+/* reuseHierarchy: whether the kept hierarchy may serve this solve in slot
+ * space (same slots, same epoch, its iterations not grown too far). */
+static bool may_keep(const pcg_boomeramg *d, const mf_row_names *rows)
+{
+    if (!d->amg || !d->slot_space || rows->nslots != d->nslots || rows->epoch != d->epoch)
+        return false;
+    const int first = d->first_iterations;
+    if (first < 0)
+        return true;
+    const double bound = fmax(d->s.rebuild_ratio * first, first + 2.0);
+    return d->last_iterations <= bound;
+}
+
+static int precond_prepare(void *ctx, const mf_csr *A, const mf_row_names *rows, mf_hypre_precond *pc)
 {
     pcg_boomeramg *d = ctx;
     d->reused = false;
+    if (rows && d->s.reuse_hierarchy) {
+        if (may_keep(d, rows)) {
+            d->reused = true;
+            *pc = (mf_hypre_precond){HYPRE_BoomerAMGSolve, keep_hierarchy, d->amg};
+            return 0;
+        }
+        discard_hierarchy(d);
+        MF_CALL(create_amg(&d->s, &d->amg));
+        d->slot_space = true;
+        d->nslots = rows->nslots;
+        d->epoch = rows->epoch;
+        d->first_iterations = -1;
+        *pc = (mf_hypre_precond){HYPRE_BoomerAMGSolve, HYPRE_BoomerAMGSetup, d->amg};
+        return 0;
+    }
+    if (d->slot_space) /* set up in slot space: of no use to a system in rows */
+        discard_hierarchy(d);
     if (d->s.reuse_setup > 0) {
         uint64_t pattern = 0;
         MF_CALL(mf_hypre_pattern_hash(A, &pattern));
@@ -188,22 +265,32 @@ static int precond_prepare(void *ctx, const mf_csr *A, mf_hypre_precond *pc)
     return 0;
 }
 
-static void precond_release(void *ctx, bool converged)
+static void precond_release(void *ctx, const mf_solve_report *rep, bool converged)
 {
     pcg_boomeramg *d = ctx;
-    /* Keep the hierarchy only if it may serve again and just did its job. */
-    if (d->s.reuse_setup == 0 || !converged)
+    if (!converged) { /* the retry (pcg_boomeramg_solve) starts from a fresh one */
+        discard_hierarchy(d);
+        return;
+    }
+    if (d->slot_space) {
+        if (d->first_iterations < 0)
+            d->first_iterations = rep->iterations;
+        d->last_iterations = rep->iterations;
+        return;
+    }
+    /* Keep the hierarchy only if it may serve again. */
+    if (d->s.reuse_setup == 0)
         discard_hierarchy(d);
 }
 
-static int pcg_boomeramg_solve(void *data, const mf_csr *A, const double *b, double *x,
-                               mf_solve_report *rep)
+static int solve_impl(pcg_boomeramg *d, const mf_csr *A, const mf_row_names *rows, const double *b,
+                      double *x, mf_solve_report *rep)
 {
-    pcg_boomeramg *d = data;
     const mf_hypre_pcg pcg = {
         .name = module_name,
         .tolerance = d->s.tolerance,
         .max_iter = d->s.max_iter,
+        .rows = d->s.reuse_hierarchy ? rows : NULL,
         .precond_prepare = precond_prepare,
         .precond_release = precond_release,
         .ctx = d,
@@ -212,7 +299,7 @@ static int pcg_boomeramg_solve(void *data, const mf_csr *A, const double *b, dou
     if (rep == NULL)
         rep = &local;
     d->reused = false;
-    if (d->s.reuse_setup == 0 || d->amg == NULL || A == NULL || x == NULL) {
+    if (d->amg == NULL || A == NULL || x == NULL) {
         MF_CALL(mf_hypre_pcg_solve(&pcg, A, b, x, rep));
         return 0;
     }
@@ -240,6 +327,18 @@ static int pcg_boomeramg_solve(void *data, const mf_csr *A, const double *b, dou
     return 0;
 }
 
+static int pcg_boomeramg_solve(void *data, const mf_csr *A, const double *b, double *x,
+                               mf_solve_report *rep)
+{
+    return solve_impl(data, A, NULL, b, x, rep);
+}
+
+static int pcg_boomeramg_solve_rows(void *data, const mf_csr *A, const mf_row_names *rows,
+                                    const double *b, double *x, mf_solve_report *rep)
+{
+    return solve_impl(data, A, rows, b, x, rep);
+}
+
 static void pcg_boomeramg_destroy(void *data)
 {
     pcg_boomeramg *d = data;
@@ -256,4 +355,5 @@ const mf_pressure_ops mf_pressure_PCG_BoomerAMG = {
     .create = pcg_boomeramg_create,
     .solve = pcg_boomeramg_solve,
     .destroy = pcg_boomeramg_destroy,
+    .solve_rows = pcg_boomeramg_solve_rows,
 };

@@ -39,9 +39,10 @@ static int pcg_diagonal_create(const void *settings, void **data)
 
 /* Scaling by 1/a_ii needs a positive diagonal (as any SPD matrix has); say
  * which row breaks that rather than let hypre divide by zero. */
-static int precond_prepare(void *ctx, const mf_csr *A, mf_hypre_precond *pc)
+static int precond_prepare(void *ctx, const mf_csr *A, const mf_row_names *rows, mf_hypre_precond *pc)
 {
     (void)ctx;
+    (void)rows;
     for (size_t i = 0; i < A->nrows; i++) {
         const int64_t row = A->row_offset + (int64_t)i;
         double diag = 0.0;
@@ -66,6 +67,7 @@ static int pcg_diagonal_solve(void *data, const mf_csr *A, const double *b, doub
         .name = module_name,
         .tolerance = s->tolerance,
         .max_iter = s->max_iter,
+        .rows = NULL,
         .precond_prepare = precond_prepare,
         .precond_release = NULL,
         .ctx = NULL,

@@ -7,8 +7,10 @@
  *
  * Both take the matrix as this rank's rows of an mf_csr, copy it into hypre
  * IJ/ParCSR objects (rebuilt on every solve: particles move, so the pattern
- * changes every step), solve, and report iterations and the true relative
- * residuals ||b - A x|| / ||b|| computed from the caller's CSR.
+ * changes every step; in slot space when the caller names the rows, see
+ * mf_hypre_pcg.rows), solve, and report iterations and the true relative
+ * residuals ||b - A x|| / ||b|| computed from the caller's CSR. PCG_BoomerAMG
+ * may keep its AMG hierarchy across solves (pcg_boomeramg.c).
  *
  * The caller owns MPI and hypre: MPI_Init and HYPRE_Init() before the first
  * create, HYPRE_Finalize and MPI_Finalize after the last destroy. The
@@ -29,7 +31,11 @@ typedef struct mf_pcg_boomeramg_settings {
     long interp_type;        /* hypre interpolation (6 = extended+i) */
     long p_max_elmts;        /* max interpolation weights per row (0 = no limit) */
     long relax_type;         /* smoother, must be symmetric (8 = l1 symmetric Gauss-Seidel) */
-    long reuse_setup;        /* solves that may reuse one AMG hierarchy (0 = rebuild each) */
+    long reuse_setup;        /* solves that may reuse one AMG hierarchy while the pattern is
+                                unchanged (0 = rebuild each) */
+    bool reuse_hierarchy;    /* named rows (mf_row_names): keep the hierarchy across solves */
+    double rebuild_ratio;    /* ... until a solve takes this many times the iterations of the
+                                hierarchy's first */
 } mf_pcg_boomeramg_settings;
 
 /* Settings of PCG_diagonal. */
@@ -65,12 +71,20 @@ typedef struct mf_hypre_pcg {
     const char *name; /* module name, for messages */
     double tolerance;
     long max_iter;
+    /* Optional (NULL: row space): the rows' names. On one rank the system
+     * is then assembled in slot space: slot[r] holds row r, and a slot no
+     * row names is a decoupled row d x = 0 (d the mean diagonal, b = x = 0),
+     * so that a preconditioner set up for one solve can serve a later one
+     * whose rows differ (a free-surface particle is a Dirichlet value in one
+     * step and an unknown in the next). */
+    const mf_row_names *rows;
     /* Fill *pc once the matrix is known (called after the cheap exits, so
-     * not at all for b = 0 or an initial guess that already converged). */
-    int (*precond_prepare)(void *ctx, const mf_csr *A, mf_hypre_precond *pc);
+     * not at all for b = 0 or an initial guess that already converged).
+     * rows: the slots the system is assembled in (NULL: row space). */
+    int (*precond_prepare)(void *ctx, const mf_csr *A, const mf_row_names *rows, mf_hypre_precond *pc);
     /* Called after every prepare that succeeded, whatever happened next;
-     * converged tells whether this solve reached the tolerance. */
-    void (*precond_release)(void *ctx, bool converged);
+     * converged tells whether this solve reached the tolerance, rep how. */
+    void (*precond_release)(void *ctx, const mf_solve_report *rep, bool converged);
     void *ctx;
 } mf_hypre_pcg;
 

@@ -171,6 +171,6 @@ const mf_solver_ops mf_solver_MAFL = {
     .create = mafl_create,
     .step = mafl_step_op,
     .destroy = mafl_destroy,
-    .stable_dt = NULL,
+    .stable_dt = NULL, /* the forces' limits are the time loop's (mf_stable_dt) */
     .report = mafl_report,
 };

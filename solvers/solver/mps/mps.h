@@ -39,7 +39,6 @@ typedef struct mps_settings {
     double restitution;
     long reorder_interval;    /* sort particles along cells every N steps (0: never) */
     const char *viscosity;    /* "explicit" (eq. 7 term in the explicit phase) or "implicit" */
-    double viscosity_tolerance; /* relative residual of the implicit viscous solves */
     double periodic_length;   /* period along x, m (0: no periodic axis) */
     double periodic_origin;   /* x of the periodic box's lower face, m */
 } mps_settings;
@@ -69,6 +68,8 @@ typedef struct mps_data {
     double *rhs, *x;
     mf_csr A;
     size_t cap_rows, cap_nnz;
+    int64_t *slot;     /* PPE row -> its name for the pressure module (mf_rows) */
+    size_t cap_slot;
     /* Last solve, for the log and for benchmarks. */
     mf_solve_report last;
     long ppe_rows;
@@ -112,7 +113,7 @@ typedef struct mps_data {
 enum { MPS_FLAG_SURFACE = 1 }; /* bits of the Flags field */
 
 extern const mf_solver_ops mf_solver_MPS;
-#define MPS_NPARAMS 17 /* checked against the table in mps_params.c */
+#define MPS_NPARAMS 16 /* checked against the table in mps_params.c */
 extern const mf_param mps_params[MPS_NPARAMS];
 extern const char *const mps_viscosity_choices[]; /* explicit, implicit */
 /* The entries of that table, for a solver whose settings embed an
@@ -155,9 +156,8 @@ extern const char *const mps_viscosity_choices[]; /* explicit, implicit */
      "sort particles along cells every N steps for memory locality (0: never)"},                \
     {"viscosity", MF_PARAM_WORD, "explicit", MF_NO_RANGE, mps_viscosity_choices,                 \
      OFF(viscosity),                                                                            \
-     "explicit (eq. 7 in the explicit phase, dt limited by maxDi) or implicit (hypre solve)"},   \
-    {"viscosityTolerance", MF_PARAM_SCALAR, "1e-10", 1e-16, 1e-2, NULL,                         \
-     OFF(viscosity_tolerance), "relative residual of the implicit viscous solves"},              \
+     "explicit (eq. 7 in the explicit phase, dt limited by maxDi) or implicit (the solver of "   \
+     "solverDict's viscosity { solver NAME; })"},                                                \
     {"periodicLength", MF_PARAM_SCALAR, "0", 0, 1e9, NULL, OFF(periodic_length),                 \
      "period along x, m (0: none); the walls must be open at xmin and xmax"},                    \
     {"periodicOrigin", MF_PARAM_SCALAR, "0", -1e9, 1e9, NULL, OFF(periodic_origin),             \
@@ -165,6 +165,18 @@ extern const char *const mps_viscosity_choices[]; /* explicit, implicit */
 
 
 /* mps_module.c */
+/* A linear solve of the solver (kind pressure): the module named by
+ * solverDict's `key { solver NAME; ... }` (PCG_BoomerAMG when absent),
+ * created with the case's settings and, where the case does not give them
+ * and the module has them, the solver's defaults. tolerance (may be NULL):
+ * the tolerance used, NAN if the module has none. */
+typedef struct mps_default {
+    const char *key;
+    double value;
+} mps_default;
+int mps_create_solve(const mf_sim *sim, const mf_dict *solver_dict, const char *key,
+                     const mps_default *defaults, size_t ndefaults, mf_module *out,
+                     double *tolerance);
 int mps_create_data(const mps_settings *s, mf_sim *sim, const mf_dict *solver_dict,
                     mps_data **out);
 void mps_destroy_data(mps_data *d);
@@ -208,7 +220,9 @@ double mps_apply_correction(mps_data *d, mf_particles *p, double dt, const uint8
  * mps_data.mu: rows scaled by rho_i, so the matrix stays symmetric), walls and
  * dummies as Dirichlet values (their velocity), free-surface particles in the
  * system with their missing neighbours absent. */
-int mps_viscosity_create(mps_data *d, mf_sim *sim);
+/* The solver is solverDict's `viscosity { solver NAME; ... }` (a module of
+ * kind pressure; PCG_BoomerAMG, tolerance 1e-10 by default). */
+int mps_viscosity_create(mps_data *d, mf_sim *sim, const mf_dict *solver_dict);
 void mps_viscosity_destroy(struct mps_viscosity *v);
 /* Replaces the explicit update of mps_explicit_phase: d->acc holds the force
  * accelerations; on return u = u*, r = r^n + dt u*. */

@@ -32,7 +32,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "force/forces.h"
 #include "mf_error.h"
 #include "mf_halo.h"
 #include "mps.h"
@@ -41,6 +40,7 @@ typedef struct mps_halo {
     mf_halo *h;
     mf_halo_spec spec;  /* at r^n: velocities and the fields of the explicit phase */
     mf_halo_spec star;  /* at r*: what the pressure phase reads */
+    double rmax;        /* the operators' largest radius */
 } mps_halo;
 
 static double largest_radius(const mps_data *d)
@@ -82,8 +82,6 @@ int mps_halo_create(mps_data *d, mf_sim *sim)
     const double rmax = largest_radius(d);
     if (periodic)
         MF_CALL(check_period(d, sim, rmax));
-    /* The forces read their neighbours through the same copies. */
-    const double radius = fmax(rmax, mf_forces_radius(sim));
     mps_halo *mh = calloc(1, sizeof *mh);
     if (!mh)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory");
@@ -92,7 +90,7 @@ int mps_halo_create(mps_data *d, mf_sim *sim)
         free(mh);
         return mf_error_trace(rc, __FILE__, __LINE__, __func__);
     }
-    mh->spec.radius = radius;
+    mh->rmax = rmax; /* the copies' reach: mps_halo_add */
     mh->spec.velocities = true; /* viscosity, the collision model, the forces */
     if (periodic) {
         mh->spec.periodic_axis = 0;
@@ -178,6 +176,10 @@ int mps_halo_add(mps_data *d, mf_sim *sim, bool at_star)
 {
     mps_halo *mh = d->halo;
     mf_particles *p = sim->p;
+    /* The copies reach every loop: the operators' and the forces' (their
+     * requests to the neighbour service, through the same copies). */
+    mh->spec.radius = mh->star.radius =
+        fmax(mh->rmax, mf_neighbours_max_radius(sim->neighbours));
     MF_CALL(mf_halo_build(mh->h, sim->par, p, at_star ? &mh->star : &mh->spec));
     MF_CALL(mps_reserve(d, p->n));
     /* What a copy is follows from its kind; what the phases compute later

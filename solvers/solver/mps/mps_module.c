@@ -2,20 +2,84 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "force/forces.h"
 #include "mf_error.h"
 #include "mps.h"
 
+static bool module_has_param(const mf_module_info *info, const char *key)
+{
+    for (size_t i = 0; i < info->nparams; i++)
+        if (strcmp(info->params[i].name, key) == 0)
+            return true;
+    return false;
+}
+
+/* The case's `key { ... }` (vd, may be NULL) with the solver's defaults
+ * added where the module declares the key and the case does not give it. */
+static int solve_dict(const mf_dict *vd, const mf_module_info *info, const mps_default *defaults,
+                      size_t ndefaults, mf_dict **out)
+{
+    mf_dict *m = mf_dict_new(info->name, NULL);
+    if (!m)
+        return MF_ERROR(MF_ERR_MEMORY, "out of memory");
+    *out = m;
+    for (size_t k = 0; vd && k < vd->n; k++) {
+        const mf_entry *e = vd->entries[k];
+        mf_value **items = calloc(e->n ? e->n : 1, sizeof *items);
+        if (!items)
+            return MF_ERROR(MF_ERR_MEMORY, "out of memory");
+        for (size_t i = 0; i < e->n; i++)
+            items[i] = mf_value_copy(e->items[i], m);
+        if (!mf_dict_set(m, e->key, e->loc, e->n, items))
+            return MF_ERROR(MF_ERR_MEMORY, "out of memory");
+    }
+    for (size_t k = 0; k < ndefaults; k++)
+        if (module_has_param(info, defaults[k].key) && !mf_dict_find(m, defaults[k].key))
+            MF_CALL(mf_dict_set_number(m, defaults[k].key, defaults[k].value));
+    return 0;
+}
+
+int mps_create_solve(const mf_sim *sim, const mf_dict *solver_dict, const char *key,
+                     const mps_default *defaults, size_t ndefaults, mf_module *out,
+                     double *tolerance)
+{
+    const mf_dict *vd = solver_dict ? mf_dict_subdict(solver_dict, key) : NULL;
+    const char *name = "PCG_BoomerAMG";
+    if (vd)
+        MF_CALL(mf_dict_get_word_or(vd, "solver", name, &name));
+    const mf_module_info *info = NULL;
+    MF_CALL(mf_registry_find(sim->reg, MF_KIND_PRESSURE, name, &info));
+    mf_dict *merged = NULL;
+    static const char *const extra[] = {"solver", NULL};
+    int rc = solve_dict(vd, info, defaults, ndefaults, &merged);
+    if (rc == 0)
+        rc = mf_module_prepare(sim->reg, MF_KIND_PRESSURE, name, merged, extra, NULL, out);
+    for (size_t k = 0; rc == 0 && vd && k < vd->n; k++) /* read through the copy */
+        vd->entries[k]->used = true;
+    if (rc == 0 && tolerance)
+        mf_dict_get_number_or(merged, "tolerance", NAN, tolerance);
+    mf_dict_free(merged);
+    MF_CALL(rc);
+    const mf_pressure_ops *ops = (const mf_pressure_ops *)out->info;
+    MF_CALL(ops->create(out->settings, &out->data));
+    return 0;
+}
+
+/* The pressure solve's defaults where the case is silent: with the AMG
+ * hierarchy kept across steps (reuseHierarchy), no aggressive coarsening in
+ * 2-D (its costlier set-up, made once per hierarchy, is repaid by fewer
+ * and cheaper iterations at every step); in 3-D the module's one level
+ * (without it the coarse levels are too dense). docs/incoming/iface.md has
+ * the measurements. */
 static int create_pressure(mps_data *d, mf_sim *sim, const mf_dict *solver_dict)
 {
     const mf_dict *pd = solver_dict ? mf_dict_subdict(solver_dict, "pressure") : NULL;
-    const char *name = "PCG_BoomerAMG";
-    if (pd)
-        MF_CALL(mf_dict_get_word_or(pd, "solver", name, &name));
-    static const char *const extra[] = {"solver", NULL};
-    MF_CALL(mf_module_prepare(sim->reg, MF_KIND_PRESSURE, name, pd, extra, NULL, &d->pressure));
+    bool reuse = true;
+    if (pd && mf_dict_find(pd, "reuseHierarchy"))
+        MF_CALL(mf_dict_get_bool(pd, "reuseHierarchy", &reuse));
+    const mps_default defaults[] = {{"aggressiveLevels", 0}};
+    MF_CALL(mps_create_solve(sim, solver_dict, "pressure", defaults,
+                             sim->dim == 2 && reuse ? 1 : 0, &d->pressure, NULL));
     d->pressure_ops = (const mf_pressure_ops *)d->pressure.info;
-    MF_CALL(d->pressure_ops->create(d->pressure.settings, &d->pressure.data));
     return 0;
 }
 
@@ -82,8 +146,16 @@ int mps_create_data(const mps_settings *s, mf_sim *sim, const mf_dict *solver_di
                                        &d->f_number_density));
     MF_CALL(mf_particles_request_field(sim->p, "Flags", 1, MF_FIELD_INT32, true, &d->f_flags));
     MF_CALL(create_pressure(d, sim, solver_dict));
-    if (strcmp(s->viscosity, "implicit") == 0)
-        MF_CALL(mps_viscosity_create(d, sim));
+    if (strcmp(s->viscosity, "implicit") == 0) {
+        MF_CALL(mps_viscosity_create(d, sim, solver_dict));
+    } else if (solver_dict && mf_dict_find(solver_dict, "viscosity")) {
+        char where[512];
+        return MF_ERROR(MF_ERR_INPUT,
+                        "%s: a viscosity { solver ...; } dictionary, but the viscosity is "
+                        "explicit: set viscosity implicit; in the solver's Coeffs, or remove it",
+                        mf_loc_str(mf_dict_find(solver_dict, "viscosity")->loc, where,
+                                   sizeof where));
+    }
     MF_CALL(mps_reserve(d, sim->p->n));
     MF_CALL(mps_halo_create(d, sim)); /* copies from other ranks (none in a serial run) */
     const mf_kernel *ks[3] = {&d->k_nd, &d->k_grad, &d->k_lap};
@@ -113,6 +185,7 @@ void mps_destroy_data(mps_data *d)
     free(d->not_dummy);
     free(d->row);
     free(d->row_global);
+    free(d->slot);
     free(d->rhs);
     free(d->x);
     free(d->A.rowptr);
@@ -157,14 +230,6 @@ static int mps_step(void *data, mf_sim *sim, double dt)
 }
 
 static void mps_destroy(void *data) { mps_destroy_data(data); }
-
-/* The forces' own limit (the capillary step of surfaceTension), if any. */
-static int mps_stable_dt(void *data, const mf_sim *sim, double *dt)
-{
-    (void)data;
-    *dt = mf_forces_stable_dt(sim);
-    return 0;
-}
 
 static void mps_report(void *data, const mf_sim *sim, mf_log *log)
 {
@@ -221,6 +286,6 @@ const mf_solver_ops mf_solver_MPS = {
     .create = mps_create,
     .step = mps_step,
     .destroy = mps_destroy,
-    .stable_dt = mps_stable_dt,
+    .stable_dt = NULL, /* the forces' limits are the time loop's (mf_stable_dt) */
     .report = mps_report,
 };

@@ -24,6 +24,7 @@
 #include <string.h>
 
 #include "mf_error.h"
+#include "mf_hash.h"
 #include "mf_run.h"
 #include "mps.h"
 
@@ -456,17 +457,50 @@ static int solve_failed(mps_data *d, const mf_sim *sim)
                     mf_particle_kind_name(w.kind), w.id, w.x[0], w.x[1], w.x[2]);
 }
 
+/* The rows' names for the pressure module (mf_row_names): slot = the particle's
+ * rank among the non-dummy particles (the PPE's possible unknowns), the
+ * epoch a fingerprint of which particles those are, in which order, and of
+ * what is solved for (multiFluid's two-step solve alternates two equations
+ * on one module: each its own epoch) and of the snapshots written (see
+ * mf_sim.snapshot_epoch). A module may then keep its
+ * preconditioner from step to step while the free surface and the neighbour
+ * pairs change (pcg_boomeramg.c). */
+static int name_rows(mps_data *d, const mf_sim *sim, mf_row_names *rows)
+{
+    const mf_particles *p = sim->p;
+    if (d->A.nrows > d->cap_slot) {
+        size_t cap = d->A.nrows + d->A.nrows / 4 + 64;
+        int64_t *grown = realloc(d->slot, cap * sizeof *grown);
+        if (!grown)
+            return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu pressure unknowns", cap);
+        d->slot = grown;
+        d->cap_slot = cap;
+    }
+    uint64_t h = mf_hash_word(MF_HASH_START, p->n_owned);
+    h = mf_hash_word(h, (uint64_t)sim->snapshot_epoch); /* restarts repeat runs exactly */
+    for (const char *c = d->solve_name; c && *c; c++)
+        h = mf_hash_word(h, (uint64_t)(unsigned char)*c);
+    int64_t k = 0;
+    for (size_t i = 0; i < p->n_owned; i++) {
+        if (!d->not_dummy[i])
+            continue;
+        h = mf_hash_word(h, (uint64_t)p->id[i]);
+        if (d->row[i] >= 0)
+            d->slot[d->row[i]] = k;
+        k++;
+    }
+    *rows = (mf_row_names){d->slot, k, h};
+    return 0;
+}
+
 int mps_solve_ppe(mps_data *d, mf_sim *sim)
 {
     double t0 = mf_wall_seconds();
     mf_particles *p = sim->p;
-    int rc = d->pressure_ops->solve(d->pressure.data, &d->A, d->rhs, d->x, &d->last);
-    mf_log_printf(sim->log, MF_LOG_STEP,
-                  "%s:  Solving for %s, Initial residual = %g, Final residual = %g, No "
-                  "Iterations %d\n",
-                  d->pressure.info->name, d->solve_name ? d->solve_name : "p",
-                  d->last.initial_residual, d->last.final_residual,
-                  d->last.iterations);
+    mf_row_names rows;
+    MF_CALL(name_rows(d, sim, &rows));
+    int rc = mf_pressure_solve_rows(&d->pressure, sim, d->solve_name ? d->solve_name : "p",
+                                    &d->A, &rows, d->rhs, d->x, &d->last);
     sim->pressure_iterations += d->last.iterations;
     d->solves++;
     d->t_setup += d->last.setup_seconds;

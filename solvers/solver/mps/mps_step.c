@@ -75,10 +75,7 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
     mf_particles *p = sim->p;
     const double nu = sim->fluid[0].nu;
     memset(d->acc, 0, 3 * p->n * sizeof *d->acc);
-    for (size_t k = 0; k < sim->nforces; k++) {
-        const mf_force_ops *ops = (const mf_force_ops *)sim->forces[k].info;
-        MF_CALL(ops->accumulate(sim->forces[k].data, sim, d->acc));
-    }
+    MF_CALL(mf_force_accumulate(sim, d->acc));
     if (d->visc) { /* viscosity implicit: u* = (I - dt nu lap)^-1 (u + dt a), r* = r + dt u* */
         MF_CALL(mps_viscosity_implicit(d, sim, dt));
     } else if (d->mu || nu > 0) {

@@ -12,8 +12,9 @@
  * free-surface particle keeps its row, its missing neighbours simply absent
  * (the explicit term does the same). The matrix
  *   A_ii = 1 + dt nu c sum_j w_ij,  A_ij = -dt nu c w_ij  (j fluid)
- * is symmetric and strictly diagonally dominant, hence SPD: hypre PCG with
- * BoomerAMG (the pressure module PCG_BoomerAMG, a second instance of it).
+ * is symmetric and strictly diagonally dominant, hence SPD: a linear-solver
+ * module (kind pressure) named by solverDict's `viscosity { solver NAME; }`
+ * like the pressure's, PCG_BoomerAMG by default (a second instance).
  * With a viscosity per particle (mps_data.mu, multi-fluid, eq. 27) row i is
  * multiplied by rho_i: A_ii = rho_i + dt c sum_j mu_ij w_ij, A_ij = -dt c
  * mu_ij w_ij, which keeps it symmetric since mu_ij is a symmetric average.
@@ -26,10 +27,9 @@
 #include "mf_error.h"
 #include "mf_run.h"
 #include "mps.h"
-#include "pressure/pressure_hypre.h"
 
 typedef struct mps_viscosity {
-    mf_module solver; /* a PCG_BoomerAMG instance of its own */
+    mf_module solver; /* a linear-solver module of its own (solverDict `viscosity`) */
     const mf_pressure_ops *ops;
     mf_csr A;
     double *b, *x;
@@ -40,26 +40,24 @@ typedef struct mps_viscosity {
     double seconds;
 } mps_viscosity;
 
-int mps_viscosity_create(mps_data *d, mf_sim *sim)
+int mps_viscosity_create(mps_data *d, mf_sim *sim, const mf_dict *solver_dict)
 {
     mps_viscosity *v = calloc(1, sizeof *v);
     if (!v)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory");
     d->visc = v;
-    MF_CALL(mf_module_prepare(sim->reg, MF_KIND_PRESSURE, "PCG_BoomerAMG", NULL, NULL, NULL,
-                              &v->solver));
+    /* Defaults where the case is silent: a tighter tolerance than the
+     * pressure's (the solve is cheap, a few iterations), and one AMG set-up
+     * for the dim components, which share the matrix. */
+    const mps_default defaults[] = {{"tolerance", 1e-10}, {"reuseSetup", sim->dim - 1}};
+    double tolerance = NAN;
+    MF_CALL(mps_create_solve(sim, solver_dict, "viscosity", defaults, 2, &v->solver, &tolerance));
     v->ops = (const mf_pressure_ops *)v->solver.info;
-    mf_pcg_boomeramg_settings *s = v->solver.settings;
-    s->tolerance = d->s.viscosity_tolerance;
-    /* The components share one matrix: one AMG set-up serves them all. */
-    s->reuse_setup = sim->dim - 1;
-    MF_CALL(v->ops->create(v->solver.settings, &v->solver.data));
     /* The viscous limit of the time step does not apply any more. */
     sim->viscosity_implicit = true;
     mf_log_printf(sim->log, MF_LOG_NORMAL,
-                  "Viscosity: implicit (PCG_BoomerAMG, tolerance %g); no viscous time-step "
-                  "limit\n",
-                  s->tolerance);
+                  "Viscosity: implicit (%s, tolerance %g); no viscous time-step limit\n",
+                  v->solver.info->name, tolerance);
     return 0;
 }
 
@@ -254,12 +252,7 @@ int mps_viscosity_implicit(mps_data *d, mf_sim *sim, double dt)
             v->b[r] = (d->rho ? d->rho[i] : 1.0) * ut + dirichlet[3 * r + c];
         }
         mf_solve_report rep;
-        rc = v->ops->solve(v->solver.data, &v->A, v->b, v->x, &rep);
-        mf_log_printf(sim->log, MF_LOG_STEP,
-                      "%s:  Solving for %s, Initial residual = %g, Final residual = %g, No "
-                      "Iterations %d\n",
-                      v->solver.info->name, names[c], rep.initial_residual, rep.final_residual,
-                      rep.iterations);
+        rc = mf_pressure_solve(&v->solver, sim, names[c], &v->A, v->b, v->x, &rep);
         v->solves++;
         v->iterations += rep.iterations;
         if (rc == 0)

@@ -4,7 +4,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "force/forces.h"
 #include "mf_error.h"
 #include "multifluid.h"
 
@@ -173,14 +172,6 @@ static int multifluid_step_op(void *data, mf_sim *sim, double dt)
 
 static void multifluid_destroy(void *data) { destroy_data(data); }
 
-/* The capillary limit of the forces (surface tension), if any. */
-static int multifluid_stable_dt(void *data, const mf_sim *sim, double *dt)
-{
-    (void)data;
-    *dt = mf_forces_stable_dt(sim);
-    return 0;
-}
-
 static void multifluid_report(void *data, const mf_sim *sim, mf_log *log)
 {
     const multifluid_data *d = data;
@@ -201,6 +192,6 @@ const mf_solver_ops mf_solver_multiFluid = {
     .create = multifluid_create,
     .step = multifluid_step_op,
     .destroy = multifluid_destroy,
-    .stable_dt = multifluid_stable_dt,
+    .stable_dt = NULL, /* the forces' limits are the time loop's (mf_stable_dt) */
     .report = multifluid_report,
 };

@@ -165,17 +165,6 @@ typedef struct fmm {
     bucket_queue q;
 } fmm;
 
-/* Global coordinates of a handle. */
-static inline void handle_coords(const ls_band *band, uint32_t h, int32_t *x, int32_t *y,
-                                 int32_t *z)
-{
-    const int32_t *c = &band->b.coord[3 * (h / LS_B3)];
-    int l = (int)(h % LS_B3);
-    *x = LS_B * c[0] + (l & 7);
-    *y = LS_B * c[1] + ((l >> 3) & 7);
-    *z = LS_B * c[2] + (l >> 6);
-}
-
 /* Neighbour of handle h by one step along axis a (0..2), direction s (+-1):
  * within the brick directly, else through the hash (adding the brick when
  * `create`). Returns false when absent. */
