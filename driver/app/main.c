@@ -305,8 +305,21 @@ static void openmp_wait_policy(char **argv)
     execv("/proc/self/exe", argv); /* returns only on failure: go on as we are */
 }
 
+/* hwloc (which OpenMPI's MPI_Init and its singleton orted load) probes
+ * the X displays :0, :1, ... for GPUs through its GL plugin. A run does not
+ * need GPUs, and a busy X server on the machine (an Xvfb of a ParaView
+ * test) made the probe fail with Xlib's "XIO: fatal IO error", which exits
+ * the process. Leave the plugin out unless the user chose hwloc's
+ * components. Before the re-exec below, so that every process inherits it. */
+static void hwloc_without_displays(void)
+{
+    if (!getenv("HWLOC_COMPONENTS"))
+        setenv("HWLOC_COMPONENTS", "-gl", 1);
+}
+
 int main(int argc, char **argv)
 {
+    hwloc_without_displays();
     openmp_wait_policy(argv);
     /* Whole lines reach a redirected log at once (tail -f, a kill). */
     setvbuf(stdout, NULL, _IOLBF, 0);
