@@ -24,6 +24,7 @@
  */
 #ifndef MF_HALO_H
 #define MF_HALO_H
+#pragma GCC visibility push(default) /* the plugin API (an installed header) */
 
 #include <stdbool.h>
 #include <stddef.h>
@@ -73,4 +74,5 @@ bool mf_halo_active(const mf_halo *h);
  * the owned index; SIZE_MAX for a copy of another rank's particle. */
 size_t mf_halo_local_owner(const mf_halo *h, const mf_particles *p, size_t j);
 
+#pragma GCC visibility pop
 #endif

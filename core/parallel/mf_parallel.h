@@ -26,6 +26,7 @@
  */
 #ifndef MF_PARALLEL_H
 #define MF_PARALLEL_H
+#pragma GCC visibility push(default) /* the plugin API (an installed header) */
 
 #include <stdbool.h>
 #include <stddef.h>
@@ -165,4 +166,5 @@ int mf_parallel_owner_of(const mf_parallel *par, const double x[3]);
  * function object). Collective. */
 int mf_parallel_gather(mf_parallel *par, const mf_particles *p, int root, mf_particles **out);
 
+#pragma GCC visibility pop
 #endif

@@ -100,7 +100,11 @@ int mps_halo_create(mps_data *d, mf_sim *sim)
                       d->s.periodic_origin, d->s.periodic_origin + d->s.periodic_length, rmax);
     }
     mh->star = mh->spec;
-    mh->star.velocities = false; /* the PPE and the correction read none */
+    /* At r* the paper's PPE and the correction read no velocity; the mixed
+     * and error-compensating sources read the neighbours' u* (div u*,
+     * Dn/Dt at r*: mps_source_terms). */
+    mh->star.velocities = d->sc.source == MPS_SOURCE_MIXED ||
+                          d->sc.source == MPS_SOURCE_ERROR_COMPENSATING;
     d->halo = mh;
     return 0;
 }
