@@ -169,11 +169,27 @@ int tc_case_from_dir(tc_case *c, const char *exe, const char *tag, const char *s
 
 int tc_case_run(tc_case *c, const char *command, const char *const *args)
 {
+    return tc_case_run_np(c, 0, command, args);
+}
+
+int tc_case_run_np(tc_case *c, int np, const char *command, const char *const *args)
+{
     const char *argv[64];
+    char np_text[16];
     int argc = 0;
+    if (np > 0) {
+        snprintf(np_text, sizeof np_text, "%d", np);
+        argv[argc++] = "mpirun";
+        argv[argc++] = "--oversubscribe";
+        argv[argc++] = "--allow-run-as-root";
+        argv[argc++] = "-np";
+        argv[argc++] = np_text;
+    }
     argv[argc++] = c->exe;
     if (command && strcmp(command, "run") != 0)
         argv[argc++] = command;
+    if (np > 0)
+        argv[argc++] = "-parallel";
     argv[argc++] = "-case";
     argv[argc++] = c->dir;
     for (size_t k = 0; args && args[k] && argc < 63; k++)
@@ -210,8 +226,8 @@ int tc_case_run(tc_case *c, const char *command, const char *const *args)
         dup2(fd, STDERR_FILENO);
         close(fd);
         setenv("OMP_NUM_THREADS", threads && *threads ? threads : "1", 1);
-        execv(c->exe, (char *const *)argv);
-        fprintf(stderr, "case_util: cannot run %s (%s)\n", c->exe, strerror(errno));
+        execvp(argv[0], (char *const *)argv);
+        fprintf(stderr, "case_util: cannot run %s (%s)\n", argv[0], strerror(errno));
         _exit(127);
     }
     int status = 0;

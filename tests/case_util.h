@@ -57,6 +57,9 @@ int tc_case_write(const tc_case *c, const char *rel, const char *text);
  * command line. Returns the exit status (128 + signal if killed, -1 if it
  * could not start). */
 int tc_case_run(tc_case *c, const char *command, const char *const *args);
+/* The same on np MPI ranks: `mpirun --oversubscribe --allow-run-as-root -np
+ * np mpsflow [command] -parallel -case DIR args...` (np 0: tc_case_run). */
+int tc_case_run_np(tc_case *c, int np, const char *command, const char *const *args);
 
 /* Print the last `lines` lines of DIR/log to stderr (after a failure). */
 void tc_case_log_tail(const tc_case *c, int lines);

@@ -7,6 +7,7 @@ together.
 
     core/base                       errors, log, utilities
     core/particles, core/output     particle kernel; output data types
+    core/parallel                   distributed particle set (MPI, Zoltan)
     core/host                       dictionaries, parameters, registry, sim state
     core/scene                      scene building
     core/run                        time loop, the run's watch
@@ -24,13 +25,15 @@ import os
 import re
 import sys
 
-CORE = ["core/base", "core/particles", "core/output", "core/host", "core/scene", "core/run"]
+CORE = ["core/base", "core/particles", "core/parallel", "core/output", "core/host", "core/scene", "core/run"]
 ALLOWED = {
     "core/base": ["core/base"],
     "core/particles": ["core/base", "core/particles"],
     "core/output": ["core/base", "core/output"],
-    "core/host": ["core/base", "core/particles", "core/output", "core/host"],
-    "core/scene": ["core/base", "core/particles", "core/output", "core/host", "core/scene"],
+    "core/parallel": ["core/base", "core/particles", "core/parallel"],
+    "core/host": ["core/base", "core/particles", "core/parallel", "core/output", "core/host"],
+    "core/scene": ["core/base", "core/particles", "core/parallel", "core/output", "core/host",
+                   "core/scene"],
     "core/run": CORE,
     "solvers": CORE + ["solvers"],
     "io": CORE + ["io"],

@@ -345,7 +345,7 @@ EXPECTED.update({
     'unknown command':
         "mpsflow: unknown command 'modulse' (did you mean 'modules'?)",
     'unknown module':
-        "--> mpsflow FATAL ERROR: no module or case dictionary named 'MSP' (did you mean 'MPS'?); known: MPS, multiFluid, MAFL, PCG_BoomerAMG, PCG_diagonal, upwind, QUICK, gravity, surfaceTension, drag, surface, levelSet, blobby, hdf5, controlDict, watch, geometry, fluids, validation, compareDict, stabilityDict",
+        "--> mpsflow FATAL ERROR: no module or case dictionary named 'MSP' (did you mean 'MPS'?); known: MPS, multiFluid, MAFL, PCG_BoomerAMG, PCG_diagonal, upwind, QUICK, gravity, surfaceTension, drag, surface, levelSet, blobby, hdf5, controlDict, watch, geometry, fluids, validation, compareDict, stabilityDict, decomposeParDict",
     'misspelt key':
         "--> mpsflow FATAL ERROR: {case}/system/controlDict:15:1: unknown key 'endTme' in '(top level)' (did you mean 'endTime'?); valid keys: application, startTime, endTime, deltaT, adjustTimeStep, maxCo, maxDi, maxDeltaT, minDeltaT, writeControl, writeInterval, writer, startFrom, maxRetries, maxMemory, stopAt, runTimeModifiable, purgeWrite, FoamFile, libs, functions, watch, writerCoeffs",
     'wrong type':

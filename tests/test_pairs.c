@@ -493,7 +493,7 @@ static void check_assembly(const mf_particles *p, const mf_pairs *v, double cell
         col_of[i] = p->kind[i] == MF_FLUID ? (long)rows++ : -1;
         value[i] = uniform();
     }
-    lap_rows c = {*v, {col_of, 7, calloc(rows + 1, sizeof(size_t)), NULL, NULL}, value,
+    lap_rows c = {*v, {col_of, 7, calloc(rows + 1, sizeof(size_t)), NULL, NULL, NULL}, value,
                   calloc(rows + 1, sizeof(double)), calloc(rows + 1, sizeof(double)), 0};
     size_t failed = 0;
     CHECK_OK(mf_pairs_assemble(v, col_of, c.rows.rowptr, rows, w_count, w_sized, w_row, &c,

@@ -34,7 +34,7 @@ void mf_log_printf(mf_log *log, int level, const char *fmt, ...)
 
 void mf_log_progress(mf_log *log, double time, double end_time, double elapsed)
 {
-    if (!log->progress)
+    if (!log->progress || !log->out)
         return;
     double frac = end_time > 0 ? time / end_time : 1.0;
     if (frac > 1) frac = 1;
@@ -52,7 +52,7 @@ void mf_log_progress(mf_log *log, double time, double end_time, double elapsed)
 
 void mf_log_progress_end(mf_log *log)
 {
-    if (log->progress_shown) {
+    if (log->progress_shown && log->out) {
         fputc('\n', log->out);
         log->progress_shown = false;
     }

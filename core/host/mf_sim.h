@@ -13,6 +13,8 @@
 #include "mf_dict.h"
 #include "mf_log.h"
 #include "mf_neighbours.h"
+#include "mf_halo.h"
+#include "mf_parallel.h"
 #include "mf_particles.h"
 #include "mf_registry.h"
 
@@ -103,6 +105,13 @@ typedef struct mf_sim {
     bool viscosity_implicit;
     const mf_registry *reg;
     mf_log *log;
+    /* The ranks of a -parallel run (mf_parallel.h); NULL for a serial run. */
+    mf_parallel *par;
+    /* The copies [n_owned, n) of the particles while a solver's step runs
+     * (mf_halo.h: other ranks' particles, periodic images), for a force that
+     * needs its own intermediate values on them (mf_halo_update); NULL when
+     * there are none. */
+    mf_halo *halo;
     /* Statistics the driver reports (filled by modules). */
     long pressure_iterations;  /* summed over the run */
     /* Transported scalars ("dye", "temperature"): optional particle fields of

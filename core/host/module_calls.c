@@ -58,9 +58,10 @@ int mf_force_accumulate(mf_sim *sim, double *acc)
             rc = ops->write_fields(m->data, sim);
         m->calls++;
         m->seconds += mf_wall_seconds() - t0;
-        if (rc != 0)
-            return mf_error_trace(rc, __FILE__, __LINE__, __func__);
-        MF_CALL(check_accelerations(sim, m->info->name, a));
+        if (rc == 0)
+            rc = check_accelerations(sim, m->info->name, a);
+        /* On several ranks every rank stops, naming what failed where. */
+        MF_CALL(mf_parallel_agree(sim->par, rc));
     }
     const int ff = mf_particles_field_index(p, "FluidId");
     double power = 0;
@@ -163,14 +164,15 @@ int mf_pressure_solve_rows(mf_module *m, const mf_sim *sim, const char *field, c
                   m->info->name, field, rep->initial_residual, rep->final_residual,
                   rep->iterations);
     if (rc != 0)
-        return mf_error_trace(rc, __FILE__, __LINE__, __func__);
-    for (size_t r = 0; A && r < A->nrows; r++)
+        rc = mf_error_trace(rc, __FILE__, __LINE__, __func__);
+    for (size_t r = 0; rc == 0 && A && r < A->nrows; r++)
         if (!isfinite(x[r]))
-            return MF_ERROR(MF_ERR_NUMERIC,
-                            "unstable (nonFinite) at time %g, step %ld: %s returned a "
-                            "non-finite %s in row %zu of %zu",
-                            sim->time, sim->step, m->info->name, field, r, A->nrows);
-    return 0;
+            rc = MF_ERROR(MF_ERR_NUMERIC,
+                          "unstable (nonFinite) at time %g, step %ld: %s returned a "
+                          "non-finite %s in row %zu of %zu",
+                          sim->time, sim->step, m->info->name, field, r, A->nrows);
+    /* The solve is collective: on several ranks one outcome for all. */
+    return mf_parallel_agree(sim->par, rc);
 }
 
 int mf_solver_step(mf_module *solver, mf_sim *sim, double dt)

@@ -151,6 +151,9 @@ void mf_neighbours_moved(mf_neighbours *nb);
  * next call for the same cell. */
 int mf_neighbours_pairs(mf_neighbours *nb, const mf_particles *p, int handle,
                         struct mf_pairs *out);
+/* The largest radius any request asked for (0: none): how far a rank's
+ * copies of other ranks' particles must reach for every module's loops. */
+double mf_neighbours_max_radius(const mf_neighbours *nb);
 /* mf_neighbours_moved, then the handle's lists at once (the solver's
  * neighbour phase: the time goes there and not into the first loop). */
 int mf_neighbours_update(mf_neighbours *nb, const mf_particles *p, int handle);

@@ -149,10 +149,14 @@ MF_ENGINE void mf_pairs_each(const mf_pairs *v, const uint8_t *imask, mf_row_fn 
 /* Rows of a sparse matrix (CSR, global columns) being assembled. */
 typedef struct mf_rows {
     const long *col_of;  /* particle -> local column (>= 0), or -1: a known value */
-    int64_t col_offset;  /* global column = col_offset + col_of[j] */
+    int64_t col_offset;  /* global column = col_offset + col_of[j] ... */
     size_t *rowptr;      /* rows + 1 */
     int32_t *col;        /* 32-bit global columns (mf_csr) */
     double *val;
+    /* ... or, when not NULL, global_col[j]: the copies [n_owned, n) of other
+     * ranks' particles hold their owners' global columns (col_of of a copy
+     * only says whether it has one, >= 0). */
+    const long *global_col;
 } mf_rows;
 
 /* Does the pair take part (NULL: every pair of the view does)? */
@@ -209,8 +213,9 @@ MF_ENGINE double mf_pairs_row_assemble(const mf_pairs *v, size_t i, const uint8_
     double *val = rows->val;
     const int64_t offset = rows->col_offset;
     const double xi = pos[3 * i], yi = pos[3 * i + 1], zi = pos[3 * i + 2];
+    const long *global = rows->global_col;
     size_t at = rows->rowptr[row];
-    col[at++] = (int32_t)(offset + col_of[i]);
+    col[at++] = (int32_t)(global ? global[i] : offset + col_of[i]);
     double sum = 0.0;
     mf_pair pr;
     pr.i = i;
@@ -224,7 +229,7 @@ MF_ENGINE double mf_pairs_row_assemble(const mf_pairs *v, size_t i, const uint8_
         sum += a;
         const long c = col_of[j];
         if (c >= 0) {
-            col[at] = (int32_t)(offset + c);
+            col[at] = (int32_t)(global ? global[j] : offset + c);
             val[at++] = -a;
         } else if (known) {
             known(acc, ctx, &pr, a);

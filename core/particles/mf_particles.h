@@ -8,11 +8,13 @@
  * Vectors are stored with three components even in 2-D (z = 0): one code
  * path, and the 2-D memory overhead is small next to the neighbour lists.
  *
- * MPI layout (one rank for now): a rank owns particles [0, n_owned) and may
- * hold halo copies after them [n_owned, n). Ids are 64-bit, unique across
- * ranks: a rank hands out ids from its own block (id_base + counter), so no
- * communication is needed to add particles. Globally indexed objects
- * (matrix rows) are a per-rank range plus an offset (global_offset).
+ * MPI layout: a rank owns particles [0, n_owned) and holds halo copies of
+ * other ranks' particles (and periodic images) after them, [n_owned, n)
+ * (core/parallel/mf_halo.h). Ids are 64-bit, unique across ranks without
+ * communication: rank r of P hands out the interleaved block id_base + r +
+ * k P (id_stride = P), so one rank's ids are exactly today's serial ones.
+ * Globally indexed objects (matrix rows) are a per-rank range plus an
+ * offset (global_offset).
  */
 #ifndef MF_PARTICLES_H
 #define MF_PARTICLES_H
@@ -59,8 +61,9 @@ typedef struct mf_particles {
     /* Distributed layout. */
     int rank, nranks;
     int64_t global_offset; /* first global row of this rank's owned particles */
-    int64_t id_base;       /* this rank's id block start */
-    int64_t next_id;       /* next id handed out (>= id_base) */
+    int64_t id_base;       /* first id of the run's blocks (all ranks) */
+    int64_t next_id;       /* next id this rank hands out (>= id_base) */
+    int64_t id_stride;     /* ranks sharing the id space (1: serial) */
 } mf_particles;
 
 int mf_particles_create(int dim, size_t cap, mf_particles **out);
@@ -92,6 +95,21 @@ static inline int32_t *mf_particles_fi(const mf_particles *p, int index)
 {
     return (int32_t *)p->field[index].data;
 }
+
+/* Ids from here on: rank `rank` of `nranks` hands out first + rank + k nranks
+ * (first: the smallest id no rank has used, e.g. a snapshot's NextId). */
+void mf_particles_set_id_block(mf_particles *p, int64_t first, int rank, int nranks);
+
+/* Bytes of one particle's element of a field. */
+size_t mf_particles_field_bytes(const mf_field *f);
+/* Whole particles packed into one buffer (every array, fields included, in
+ * the order of the store), so that they can move between ranks:
+ * mf_particles_packed_bytes is the size of one; pack writes n of them
+ * (indices idx) at buf; append_packed appends n owned particles from buf
+ * (no halo may be present). */
+size_t mf_particles_packed_bytes(const mf_particles *p);
+void mf_particles_pack(const mf_particles *p, const size_t *idx, size_t n, void *buf);
+int mf_particles_append_packed(mf_particles *p, const void *buf, size_t n);
 
 void mf_particles_count_kinds(const mf_particles *p, size_t counts[MF_NKINDS]);
 size_t mf_particles_memory(const mf_particles *p); /* bytes held */

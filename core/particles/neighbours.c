@@ -97,6 +97,14 @@ int mf_neighbours_create(mf_neighbours **out)
     return 0;
 }
 
+double mf_neighbours_max_radius(const mf_neighbours *nb)
+{
+    double r = 0;
+    for (int k = 0; nb && k < nb->nhandles; k++)
+        r = fmax(r, nb->handle[k].radius);
+    return r;
+}
+
 void mf_neighbours_destroy(mf_neighbours *nb)
 {
     if (!nb)

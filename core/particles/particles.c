@@ -39,6 +39,11 @@ static size_t field_elem_size(const mf_field *f)
     return (size_t)f->ncomp * scalar;
 }
 
+size_t mf_particles_field_bytes(const mf_field *f)
+{
+    return field_elem_size(f);
+}
+
 /* Lists every per-particle array of p; returns how many. */
 static int list_arrays(mf_particles *p, array_ref refs[MAX_ARRAYS])
 {
@@ -79,6 +84,7 @@ int mf_particles_create(int dim, size_t cap, mf_particles **out)
     p->global_offset = 0;
     p->id_base = 0;
     p->next_id = 0;
+    p->id_stride = 1;
 
     int rc = mf_particles_reserve(p, cap < MIN_CAPACITY ? MIN_CAPACITY : cap);
     if (rc != 0) {
@@ -164,7 +170,8 @@ int mf_particles_add(mf_particles *p, int kind, const double x[3], const double 
         p->vel[3 * i + 2] = 0.0;
     }
     p->kind[i] = (uint8_t)kind;
-    p->id[i] = p->next_id++;
+    p->id[i] = p->next_id;
+    p->next_id += p->id_stride;
     /* The slot may hold stale values of a removed particle. */
     for (int f = 0; f < p->nfields; f++) {
         size_t es = field_elem_size(&p->field[f]);
@@ -353,6 +360,59 @@ int mf_particles_request_field(mf_particles *p, const char *name, int ncomp, int
     p->field[f] = fd;
     if (index)
         *index = f;
+    return 0;
+}
+
+void mf_particles_set_id_block(mf_particles *p, int64_t first, int rank, int nranks)
+{
+    p->id_base = first;
+    p->next_id = first + rank;
+    p->id_stride = nranks > 0 ? nranks : 1;
+}
+
+/* ---- packed particles (migration between ranks) ------------------------- */
+
+size_t mf_particles_packed_bytes(const mf_particles *p)
+{
+    array_ref refs[MAX_ARRAYS];
+    int narrays = list_arrays((mf_particles *)p, refs);
+    size_t bytes = 0;
+    for (int a = 0; a < narrays; a++)
+        bytes += refs[a].elem_size;
+    return bytes;
+}
+
+void mf_particles_pack(const mf_particles *p, const size_t *idx, size_t n, void *buf)
+{
+    array_ref refs[MAX_ARRAYS];
+    int narrays = list_arrays((mf_particles *)p, refs);
+    char *out = buf;
+    for (size_t k = 0; k < n; k++)
+        for (int a = 0; a < narrays; a++) {
+            const size_t es = refs[a].elem_size;
+            memcpy(out, (const char *)*refs[a].data + idx[k] * es, es);
+            out += es;
+        }
+}
+
+int mf_particles_append_packed(mf_particles *p, const void *buf, size_t n)
+{
+    if (p->n != p->n_owned)
+        return MF_ERROR(MF_ERR_INPUT,
+                        "cannot append particles while %zu halo particles are present",
+                        p->n - p->n_owned);
+    MF_CALL(mf_particles_reserve(p, p->n + n));
+    array_ref refs[MAX_ARRAYS];
+    int narrays = list_arrays(p, refs);
+    const char *in = buf;
+    for (size_t k = 0; k < n; k++)
+        for (int a = 0; a < narrays; a++) {
+            const size_t es = refs[a].elem_size;
+            memcpy((char *)*refs[a].data + (p->n + k) * es, in, es);
+            in += es;
+        }
+    p->n += n;
+    p->n_owned += n;
     return 0;
 }
 

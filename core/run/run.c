@@ -111,7 +111,7 @@ static double max_fluid_nu(const mf_sim *sim)
 static int diagnose_collapse(const mf_sim *sim, double dt, double floor_dt, const char *limiter)
 {
     const mf_particles *p = sim->p;
-    size_t fastest = 0;
+    size_t fastest = SIZE_MAX;
     double u2max = -1;
     for (size_t i = 0; i < p->n_owned; i++) {
         const double *v = &p->vel[3 * i];
@@ -121,15 +121,17 @@ static int diagnose_collapse(const mf_sim *sim, double dt, double floor_dt, cons
             fastest = i;
         }
     }
-    const double *x = &p->pos[3 * fastest];
+    mf_particle_info f; /* the fastest over all ranks, named on every rank */
+    mf_parallel_argmax(sim->par, &u2max, p, fastest, &f);
+    const double *x = f.x;
     return MF_ERROR(MF_ERR_NUMERIC,
                     "unstable (timeStep): the time step fell to %g s (%s limit), below "
                     "minDeltaT %g s, at "
                     "time %g: particle id %lld at (%g %g %g) moves at %g m/s. A pressure "
                     "spike feeds back through the Courant limit: try relaxation 0.2, the "
                     "collision model, or a fixed deltaT",
-                    dt, limiter, floor_dt, sim->time, (long long)p->id[fastest], x[0], x[1],
-                    x[2], sqrt(u2max));
+                    dt, limiter, floor_dt, sim->time, (long long)f.id, x[0], x[1], x[2],
+                    sqrt(fmax(u2max, 0)));
 }
 
 /* The time the step must not pass: the next write time (adjustableRunTime)
@@ -175,7 +177,9 @@ static int choose_dt(mf_run *run, double next_write, double *dt, const char **li
         land_on_target(run, next_write, dt, land);
     } else {
         mf_dt_choice ch;
-        mf_dt_choose(sim->l0, mf_max_fluid_speed(sim->p), c->max_co,
+        double umax = mf_max_fluid_speed(sim->p);
+        mf_parallel_max(sim->par, &umax, 1); /* every rank takes the same step */
+        mf_dt_choose(sim->l0, umax, c->max_co,
                      sim->viscosity_implicit ? 0.0 : max_fluid_nu(sim),
                      c->max_di, c->max_delta_t, &ch);
         double natural = ch.dt;
@@ -187,13 +191,15 @@ static int choose_dt(mf_run *run, double next_write, double *dt, const char **li
             *limiter = "growth";
         }
         /* The solver's and every force's own limit (surfaceTension's
-         * capillary step, a plugin's), whatever the solver. */
+         * capillary step, a plugin's), whatever the solver; the smallest
+         * over the ranks (the name is this rank's). */
         double sdt = INFINITY;
         const char *who = NULL;
         MF_CALL(mf_stable_dt(run->solver, sim, &sdt, &who));
+        mf_parallel_min(sim->par, &sdt, 1);
         if (sdt < natural) {
             natural = sdt;
-            *limiter = who;
+            *limiter = who ? who : "solver";
         }
         run->sim->dt_natural = natural;
         *dt = natural;
@@ -210,13 +216,17 @@ static int write_now(mf_run *run)
 {
     if (!run->writer_ops)
         return 0;
-    MF_CALL(run->writer_ops->write(run->writer->data, run->sim, run->params));
+    /* Collective, and rank 0 alone writes the index: agree on the outcome. */
+    MF_CALL(mf_parallel_agree(run->sim->par,
+                              run->writer_ops->write(run->writer->data, run->sim, run->params)));
     run->sim->snapshot_epoch++;
-    for (size_t k = 0; k < run->nfunctions; k++) {
+    int rc = 0;
+    for (size_t k = 0; k < run->nfunctions && rc == 0; k++) {
         const mf_function_object_ops *fo = (const mf_function_object_ops *)run->functions[k].info;
         if (fo->write)
-            MF_CALL(fo->write(run->functions[k].data, run->sim));
+            rc = fo->write(run->functions[k].data, run->sim);
     }
+    MF_CALL(mf_parallel_agree(run->sim->par, rc));
     run->writes++;
     MF_CALL(mf_run_after_write(run));
     return 0;
@@ -234,10 +244,30 @@ static int apply_emitters(mf_run *run, double dt, double *kinetic_in, size_t *ad
     if (!sim->emitters)
         return 0;
     const double before = mf_emitters_fluid_kinetic_energy(sim);
-    MF_CALL(mf_emitters_apply(sim->emitters, sim, dt, added, removed));
-    *kinetic_in = mf_emitters_fluid_kinetic_energy(sim) - before;
+    MF_CALL(mf_parallel_agree(sim->par, mf_emitters_apply(sim->emitters, sim, dt, added, removed)));
+    double sums[3] = {mf_emitters_fluid_kinetic_energy(sim) - before, (double)*added,
+                      (double)*removed};
+    mf_parallel_sum(sim->par, sums, 3); /* over the ranks */
+    *kinetic_in = sums[0];
+    *added = (size_t)sums[1];
+    *removed = (size_t)sums[2];
     mf_log_printf(sim->log, MF_LOG_STEP, "Emitters: added %zu, removed %zu\n", *added, *removed);
     return 0;
+}
+
+/* Courant numbers of the fluid over all ranks (the mean weighted by each
+ * rank's fluid count). */
+static void courant(const mf_sim *sim, double dt, double *mean, double *max)
+{
+    mf_courant(sim->p, dt, sim->l0, mean, max);
+    if (!sim->par)
+        return;
+    size_t counts[MF_NKINDS];
+    mf_particles_count_kinds(sim->p, counts);
+    double v[2] = {*mean * (double)counts[MF_FLUID], (double)counts[MF_FLUID]};
+    mf_parallel_sum(sim->par, v, 2);
+    *mean = v[1] > 0 ? v[0] / v[1] : 0.0;
+    mf_parallel_max(sim->par, max, 1);
 }
 
 static int step_once(mf_run *run, saved_state *saved, double next_write)
@@ -252,7 +282,7 @@ static int step_once(mf_run *run, saved_state *saved, double next_write)
     for (long attempt = 0;; attempt++) {
         sim->dt = dt;
         double courant_mean = 0, courant_max = 0;
-        mf_courant(sim->p, dt, sim->l0, &courant_mean, &courant_max);
+        courant(sim, dt, &courant_mean, &courant_max);
         mf_log_printf(sim->log, MF_LOG_STEP, "Courant Number mean: %g max: %g\n", courant_mean,
                       courant_max);
         mf_log_printf(sim->log, MF_LOG_STEP, "deltaT = %g\n", dt);
@@ -263,6 +293,8 @@ static int step_once(mf_run *run, saved_state *saved, double next_write)
         sim->forces_record.valid = false; /* set again by this attempt's forces */
         if (rc == 0)
             rc = mf_solver_step(run->solver, sim, dt);
+        /* One outcome for every rank: all retry, stop or go on together. */
+        rc = mf_parallel_agree(sim->par, rc);
         if (rc == 0) {
             sim->time = saved->time + dt; /* the watch reports the time reached */
             rc = mf_watch_check(&run->watch, sim, dt);
@@ -299,10 +331,12 @@ static int step_once(mf_run *run, saved_state *saved, double next_write)
     sim->time = isnan(land) ? sim->time + dt : land;
     sim->step++;
     run->steps++;
-    for (size_t k = 0; k < run->nfunctions; k++) {
+    int rc = 0;
+    for (size_t k = 0; k < run->nfunctions && rc == 0; k++) {
         const mf_function_object_ops *fo = (const mf_function_object_ops *)run->functions[k].info;
-        MF_CALL(fo->execute(run->functions[k].data, sim));
+        rc = fo->execute(run->functions[k].data, sim);
     }
+    MF_CALL(mf_parallel_agree(sim->par, rc));
     return 0;
 }
 

@@ -92,14 +92,33 @@ int mf_run_between_steps(mf_run *run, bool wrote, double *next_write, bool *stop
     if (run->modified) {
         const double interval = run->ctl.write_interval;
         const bool by_steps = run->ctl.write_by_steps;
-        MF_CALL(run->modified(run->modified_ctx, run));
+        /* One rank reads the changed controlDict and the others take what it
+         * found, so that every rank stops and writes at the same step. */
+        int rc = mf_parallel_is_root(sim->par) ? run->modified(run->modified_ctx, run) : 0;
+        MF_CALL(mf_parallel_agree(sim->par, rc));
+        if (sim->par) {
+            struct {
+                mf_run_control ctl;
+                double end_time;
+                int watching;
+            } b = {run->ctl, sim->end_time, run->modified != NULL};
+            mf_parallel_bcast(sim->par, &b, sizeof b, 0);
+            run->ctl = b.ctl;
+            sim->end_time = b.end_time;
+            if (!b.watching)
+                run->modified = NULL;
+        }
         if (run->ctl.write_interval != interval || run->ctl.write_by_steps != by_steps)
             *next_write = mf_run_first_write(run);
         /* endTime moved to before now: the loop ends here, with this state. */
         if (!wrote && sim->time >= sim->end_time * (1 - 1e-12))
             *write = true;
     }
-    const int sig = mf_run_signal_received();
+    /* mpirun passes a Ctrl-C to every rank, but not at the same step: the
+     * first that sees it stops them all. */
+    double seen = mf_run_signal_received();
+    mf_parallel_max(sim->par, &seen, 1);
+    const int sig = (int)seen;
     if (sig) {
         run->stop_signal = sig;
         snprintf(run->stop_reason, sizeof run->stop_reason, "stopped by signal %s",

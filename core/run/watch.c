@@ -89,7 +89,7 @@ static int check_density(mf_watch *w, const mf_sim *sim)
         return 0;
     const double *n = mf_particles_fd(sim->p, fn);
     double sum = 0;
-    size_t count = 0, thinnest = 0;
+    size_t count = 0, thinnest = SIZE_MAX;
     for (size_t i = 0; i < sim->p->n_owned; i++)
         if (sim->p->kind[i] == MF_FLUID) {
             if (count == 0 || n[i] < n[thinnest])
@@ -97,9 +97,11 @@ static int check_density(mf_watch *w, const mf_sim *sim)
             sum += n[i];
             count++;
         }
-    if (count == 0)
+    double totals[2] = {sum, (double)count}; /* over the ranks */
+    mf_parallel_sum(sim->par, totals, 2);
+    if (totals[1] == 0)
         return 0;
-    const double mean = sum / count;
+    const double mean = totals[0] / totals[1];
     if (w->n_start < 0)
         w->n_start = mean; /* the fluid as the run starts */
     /* The reference: n0, or the start's mean when lower (a sheet, a single
@@ -107,14 +109,17 @@ static int check_density(mf_watch *w, const mf_sim *sim)
     const double ref = fmin(sim->n0, w->n_start);
     if (mean >= w->s.density_collapse * ref)
         return 0;
-    const double *x = &sim->p->pos[3 * thinnest];
+    double minus_n = thinnest != SIZE_MAX ? -n[thinnest] : -INFINITY;
+    mf_particle_info t; /* the most isolated over the ranks */
+    mf_parallel_argmax(sim->par, &minus_n, sim->p, thinnest, &t);
+    const double *x = t.x;
     return MF_ERROR(MF_ERR_NUMERIC,
                     "unstable (densityCollapse) at time %g, step %ld: the mean number density "
                     "of the fluid is %.3g n0, below densityCollapse %g of %.3g n0 (%s): the "
                     "fluid has blown apart; most isolated: fluid particle id %lld at (%g %g %g)",
                     sim->time, sim->step, mean / sim->n0, w->s.density_collapse,
                     ref / sim->n0, ref < sim->n0 ? "its mean at the start" : "n0",
-                    (long long)sim->p->id[thinnest], x[0], x[1], x[2]);
+                    (long long)t.id, x[0], x[1], x[2]);
 }
 
 /* Kinetic energy; the power of the step's force accelerations a^n (what
@@ -142,6 +147,12 @@ static void energy(const mf_sim *sim, double *ke, double *power_start, double *p
         *power_end += m * (a[0] * v[0] + a[1] * v[1] + a[2] * v[2]);
         *mass_acc += m * sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
     }
+    double sums[4] = {*ke, *power_start, *power_end, *mass_acc}; /* over the ranks */
+    mf_parallel_sum(sim->par, sums, 4);
+    *ke = sums[0];
+    *power_start = sums[1];
+    *power_end = sums[2];
+    *mass_acc = sums[3];
 }
 
 static double fluid_extent(const mf_sim *sim)
@@ -152,6 +163,8 @@ static double fluid_extent(const mf_sim *sim)
             lo[c] = fmin(lo[c], sim->p->pos[3 * i + c]);
             hi[c] = fmax(hi[c], sim->p->pos[3 * i + c]);
         }
+    mf_parallel_min(sim->par, lo, 3);
+    mf_parallel_max(sim->par, hi, 3);
     double L = 0;
     for (int c = 0; c < sim->dim; c++)
         L = fmax(L, hi[c] - lo[c]);
@@ -177,6 +190,8 @@ static double surface_energy(const mf_sim *sim)
                 lo[c] = fmin(lo[c], sim->p->pos[3 * i + c] - 0.5 * sim->l0);
                 hi[c] = fmax(hi[c], sim->p->pos[3 * i + c] + 0.5 * sim->l0);
             }
+    mf_parallel_min(sim->par, lo, 3);
+    mf_parallel_max(sim->par, hi, 3);
     if (!(hi[0] > lo[0]))
         return 0;
     const double a = hi[0] - lo[0], b = hi[1] - lo[1], c = hi[2] - lo[2];
@@ -187,7 +202,7 @@ static double surface_energy(const mf_sim *sim)
 static size_t fastest_fluid(const mf_sim *sim, double *speed)
 {
     const mf_particles *p = sim->p;
-    size_t best = 0;
+    size_t best = SIZE_MAX;
     double u2max = -1;
     for (size_t i = 0; i < p->n_owned; i++) {
         if (p->kind[i] != MF_FLUID)
@@ -223,23 +238,31 @@ static int check_energy(mf_watch *w, const mf_sim *sim, double dt)
         return 0;
     double speed = 0;
     const size_t i = fastest_fluid(sim, &speed);
-    const double *x = &sim->p->pos[3 * i];
+    mf_particle_info f; /* the fastest over the ranks */
+    mf_parallel_argmax(sim->par, &speed, sim->p, i, &f);
+    const double *x = f.x;
     return MF_ERROR(MF_ERR_NUMERIC,
                     "unstable (energy) at time %g, step %ld: the fluid's kinetic energy %g J "
                     "exceeds its start %g J plus the work of the forces %g J by %g J, more "
                     "than energyTolerance %g of the energy scale %g J; fastest: fluid particle "
                     "id %lld at (%g %g %g), %g m/s",
                     sim->time, sim->step, ke, w->ke0, w->next_work, excess,
-                    w->s.energy_tolerance, scale, (long long)sim->p->id[i], x[0], x[1], x[2],
-                    speed);
+                    w->s.energy_tolerance, scale, (long long)f.id, x[0], x[1], x[2], speed);
 }
 
+/* On several ranks the local checks (nonFinite, throughWall) are agreed on
+ * once, so that every rank reports the same criterion and particle and none
+ * goes on to the collective checks alone; those (densityCollapse, energy)
+ * decide from sums over the ranks, the same on every rank, and name the
+ * particle on every rank. */
 int mf_watch_check(mf_watch *w, const mf_sim *sim, double dt)
 {
-    MF_CALL(check_non_finite(sim));
+    int rc = check_non_finite(sim);
+    if (rc == 0 && w->s.enabled)
+        rc = check_walls(sim);
+    MF_CALL(mf_parallel_agree(sim->par, rc));
     if (!w->s.enabled)
         return 0;
-    MF_CALL(check_walls(sim));
     MF_CALL(check_density(w, sim));
     MF_CALL(check_energy(w, sim, dt));
     return 0;

@@ -826,6 +826,10 @@ static int run_nozzle(mf_emitters *em, const mf_nozzle *nz, mf_sim *sim, double 
         return MF_ERROR(MF_ERR_INPUT, "nozzle '%s' would add %.0f layers in one step of %g s",
                         nz->name, k1 - k0, dt);
     mf_particles *p = sim->p;
+    /* On several ranks one adds the layers (rank 0); the next migration
+     * takes each particle to the rank whose region holds it. */
+    if (!mf_parallel_is_root(sim->par))
+        return 0;
     for (double k = k0; k < k1; k += 1) {
         /* Behind the opening by the distance it travels before this step
          * ends: the solver's step carries it out. */

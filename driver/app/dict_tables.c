@@ -13,7 +13,7 @@
 
 const char *const mf_dict_table_names[] = {"controlDict", "watch",         "geometry",
                                            "fluids",      "validation",    "compareDict",
-                                           "stabilityDict", NULL};
+                                           "stabilityDict", "decomposeParDict", NULL};
 
 static const mf_param_section control_sections[] = {
     {"controlDict", "system/controlDict: time, writing, time-step limits, memory", NULL, 0},
@@ -57,6 +57,9 @@ static void each_section(const char *name, section_fn fn, FILE *f)
     } else if (!strcmp(name, "stabilityDict")) {
         for (size_t k = 0; k < mf_stability_nsections; k++)
             fn(&mf_stability_sections[k], f);
+    } else if (!strcmp(name, "decomposeParDict")) {
+        for (size_t k = 0; k < mf_decompose_nsections; k++)
+            fn(&mf_decompose_sections[k], f);
     }
 }
 

@@ -4,6 +4,7 @@
  *   mpsflow -postProcess -func NAME | -funcs '(A B)' [-time T | -latestTime]
  *   mpsflow listTimes | modules [NAME] | validate | compare | stability | surface
  *   mpsflow -version
+ *   mpirun -np N mpsflow -parallel -case DIR     (one case on N ranks)
  */
 #include <limits.h>
 #include <math.h>
@@ -81,7 +82,8 @@ static int parse_options(int argc, char **argv, int first, mf_options *opt)
     static const char *const known[] = {"-case", "-solver", "-libs", "-dryRun", "-latestTime",
                                         "-l0", "-endTime", "-quiet", "-verbose", "-help",
                                         "-solvers", "-resolutions", "-sweeps", "-overwrite",
-                                        "-postProcess", "-func", "-funcs", "-time", "-version"};
+                                        "-postProcess", "-func", "-funcs", "-time", "-version",
+                                        "-parallel"};
     for (int i = first; i < argc; i++) {
         const char *a = argv[i];
         bool has_value = i + 1 < argc;
@@ -93,6 +95,8 @@ static int parse_options(int argc, char **argv, int first, mf_options *opt)
             opt->latest_time = true;
         else if (!strcmp(a, "-overwrite"))
             opt->overwrite = true;
+        else if (!strcmp(a, "-parallel"))
+            opt->parallel = true;
         else if (!strcmp(a, "-postProcess"))
             opt->post_process = true;
         else if (!strcmp(a, "-version"))
@@ -205,16 +209,15 @@ int mf_cmd_modules(mf_registry *reg, const char *name)
     return 0;
 }
 
-int mf_cmd_run(mf_app *app)
+/* The run itself; every rank of a -parallel run calls it. */
+static int run_case(mf_app *app)
 {
-    MF_CALL(mf_app_setup(app));
-    if (app->opt.dry_run) {
-        mf_app_summary(app);
-        printf("\nDry run: stopping before the time loop.\nEnd\n");
-        return 0;
-    }
+    /* Stale .tmp files of a killed run: one rank looks (and says so). */
     int stale = 0;
-    MF_CALL(mf_app_remove_stale_tmp(app->cs.dir, &app->log, &stale));
+    MF_CALL(mf_parallel_agree(app->sim.par,
+                              mf_parallel_is_root(app->sim.par)
+                                  ? mf_app_remove_stale_tmp(app->cs.dir, &app->log, &stale)
+                                  : 0));
     bool restart = mf_app_is_restart(app);
     if (restart) {
         const mf_writer_ops *w = (const mf_writer_ops *)app->writer.info;
@@ -224,7 +227,9 @@ int mf_cmd_run(mf_app *app)
         mf_log_printf(&app->log, MF_LOG_NORMAL, "Restarting from time %g (step %ld)\n",
                       app->sim.time, app->sim.step);
     }
-    MF_CALL(mf_case_write_resolved(&app->cs));
+    MF_CALL(mf_parallel_agree(app->sim.par, mf_app_distribute(app)));
+    if (mf_parallel_is_root(app->sim.par))
+        MF_CALL(mf_case_write_resolved(&app->cs));
     mf_app_summary(app);
     int rc = mf_run_signals_install();
     if (rc == 0)
@@ -239,6 +244,7 @@ int mf_cmd_run(mf_app *app)
     const mf_solver_ops *ops = (const mf_solver_ops *)app->solver.info;
     if (ops->report)
         ops->report(app->solver.data, &app->sim, &app->log);
+    mf_app_report_parallel(app);
     /* What the calling wrappers counted (mf_modules.h). */
     mf_log_printf(&app->log, MF_LOG_QUIET, "Solver %s: %ld steps, %.3f s\n",
                   app->solver.info->name, app->solver.calls, app->solver.seconds);
@@ -259,6 +265,28 @@ int mf_cmd_run(mf_app *app)
     return 0;
 }
 
+int mf_cmd_run(mf_app *app)
+{
+    int rc = mf_app_setup(app);
+    /* Reading the case and building the scene is the same on every rank,
+     * but a rank may still fail alone (memory): agree before the first
+     * collective step. */
+    rc = mf_parallel_agree(app->sim.par, rc);
+    if (rc == 0 && app->opt.dry_run) {
+        MF_CALL(mf_parallel_agree(app->sim.par, mf_app_distribute(app)));
+        mf_app_summary(app);
+        if (mf_parallel_is_root(app->sim.par))
+            printf("\nDry run: stopping before the time loop.\nEnd\n");
+        return 0;
+    }
+    if (rc == 0)
+        rc = run_case(app);
+    /* The time loop agrees on every step's status; this covers the rest. */
+    rc = mf_parallel_agree(app->sim.par, rc);
+    app->error_agreed = app->sim.par != NULL;
+    return rc;
+}
+
 /* OpenMP's wait policy, before anything else. libgomp's default spins a
  * waiting thread for up to 300,000 iterations at every barrier; when
  * another process holds the second core, the team's other thread is not
@@ -277,8 +305,21 @@ static void openmp_wait_policy(char **argv)
     execv("/proc/self/exe", argv); /* returns only on failure: go on as we are */
 }
 
+/* hwloc (which OpenMPI's MPI_Init and its singleton orted load) probes
+ * the X displays :0, :1, ... for GPUs through its GL plugin. A run does not
+ * need GPUs, and a busy X server on the machine (an Xvfb of a ParaView
+ * test) made the probe fail with Xlib's "XIO: fatal IO error", which exits
+ * the process. Leave the plugin out unless the user chose hwloc's
+ * components. Before the re-exec below, so that every process inherits it. */
+static void hwloc_without_displays(void)
+{
+    if (!getenv("HWLOC_COMPONENTS"))
+        setenv("HWLOC_COMPONENTS", "-gl", 1);
+}
+
 int main(int argc, char **argv)
 {
+    hwloc_without_displays();
     openmp_wait_policy(argv);
     /* Whole lines reach a redirected log at once (tail -f, a kill). */
     setvbuf(stdout, NULL, _IOLBF, 0);
@@ -330,6 +371,22 @@ int main(int argc, char **argv)
     }
     MPI_Init(&argc, &argv);
     HYPRE_Init();
+    const bool root = mf_parallel_world_rank() == 0;
+    rc = mf_app_check_parallel(&app.opt, argc, argv);
+    if (rc == 0 && command && mf_parallel_world_size() > 1 &&
+        (!strcmp(command, "compare") || !strcmp(command, "stability")))
+        rc = MF_ERROR(MF_ERR_INPUT,
+                      "%s runs the case many times as child processes and compares their run "
+                      "times: run it without mpirun (each run is serial); to time a case on N "
+                      "ranks use mpirun -np N mpsflow -parallel -case DIR",
+                      command);
+    if (rc != 0) {
+        if (root)
+            mf_error_print(stderr);
+        HYPRE_Finalize();
+        MPI_Finalize();
+        return 2;
+    }
     rc = mf_registry_create(&app.reg);
     if (rc == 0) {
         set_plugin_dirs(app.reg);
@@ -338,25 +395,29 @@ int main(int argc, char **argv)
     if (rc == 0 && app.opt.libs)
         rc = mf_app_load_libs_text(app.reg, app.opt.libs);
     double error = 0;
-    if (rc == 0 && !command && (app.opt.post_process || !app.opt.dry_run))
+    if (rc == 0 && !command && (app.opt.post_process || !app.opt.dry_run) && root)
         mf_app_banner(stdout, argc, argv, app.opt.case_dir);
-    if (rc == 0 && !command && app.opt.post_process)
-        rc = mf_cmd_post_process(&app);
-    else if (rc == 0 && !command)
+    if (rc == 0 && !command && app.opt.post_process) {
+        if (root) /* replays snapshots serially: one rank is enough */
+            rc = mf_cmd_post_process(&app);
+    } else if (rc == 0 && !command)
         rc = mf_cmd_run(&app);
-    else if (rc == 0 && !strcmp(command, "listTimes"))
+    /* Commands that read a case's files: one rank is enough. */
+    else if (rc == 0 && !strcmp(command, "listTimes") && root)
         rc = mf_cmd_list_times(&app.opt);
-    else if (rc == 0 && !strcmp(command, "modules"))
+    else if (rc == 0 && !strcmp(command, "modules") && root)
         rc = mf_cmd_modules(app.reg, module_name);
-    else if (rc == 0 && !strcmp(command, "reference"))
+    else if (rc == 0 && !strcmp(command, "reference") && root)
         rc = mf_cmd_reference(app.reg, module_name);
-    else if (rc == 0 && !strcmp(command, "validate"))
+    else if (rc == 0 && !strcmp(command, "validate") && root)
         rc = mf_cmd_validate(app.opt.case_dir, &error);
     else if (rc == 0 && !strcmp(command, "compare"))
         rc = mf_cmd_compare(&app.opt);
     else if (rc == 0 && !strcmp(command, "stability"))
         rc = mf_cmd_stability(&app.opt);
-    if (rc != 0)
+    /* A failure every rank agreed on is printed once; one that a rank met
+     * alone is printed by that rank. */
+    if (rc != 0 && (root || !app.error_agreed))
         mf_error_print(stderr);
     fflush(stdout);
     const int stop_signal = app.run.stop_signal;

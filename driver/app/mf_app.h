@@ -24,6 +24,7 @@ typedef struct mf_options {
     double l0;              /* -l0 overrides particleSpacing (0: no) */
     double end_time;        /* -endTime overrides controlDict (0: no) */
     bool dry_run, latest_time;
+    bool parallel;          /* -parallel: one case on the ranks mpirun started */
     bool overwrite;         /* -overwrite: a fresh run may replace an earlier output/ */
     int log_level;
     int argc;               /* the command line, for the log's banner */
@@ -48,6 +49,7 @@ typedef struct mf_app {
     size_t nfunctions;
     mf_module *functions;
     mf_run run;
+    bool error_agreed;      /* a -parallel run's failure is known to every rank */
     mf_scene_budget budget; /* the memory estimate the scene was checked against */
     mf_control_watch control_watch;
 } mf_app;
@@ -74,6 +76,16 @@ int mf_app_remove_stale_tmp(const char *case_dir, mf_log *log, int *removed);
 /* Print counts, kernel constants and memory (-dryRun). */
 void mf_app_summary(const mf_app *app);
 
+/* parallel_setup.c: -parallel. Started on several ranks without it: an
+ * error saying what to type. */
+int mf_app_check_parallel(const mf_options *opt, int argc, char **argv);
+/* sim.par from system/decomposeParDict (NULL on one rank: the serial run). */
+int mf_app_create_parallel(mf_app *app, mf_dict *resolved);
+/* Each rank keeps its subdomain of the particles every rank holds. */
+int mf_app_distribute(mf_app *app);
+/* The decomposition's figures at the end of a -parallel run (the log). */
+void mf_app_report_parallel(const mf_app *app);
+
 /* output/runSummary: how the run ended (status is its return code; a run
  * stopped early, by stopAt or a signal, says so from app->run.stop_reason). */
 int mf_write_run_summary(const mf_app *app, int status);
@@ -87,6 +99,8 @@ extern const mf_param_section mf_compare_sections[];
 extern const size_t mf_compare_nsections;
 extern const mf_param_section mf_stability_sections[];
 extern const size_t mf_stability_nsections;
+extern const mf_param_section mf_decompose_sections[]; /* parallel_setup.c */
+extern const size_t mf_decompose_nsections;
 /* Print the tables of the case dictionary `name` (false: no such one). */
 bool mf_dict_tables_print(const char *name, FILE *f);
 /* The names mf_dict_tables_print knows, NULL-terminated. */

@@ -26,6 +26,12 @@ static void criterion_of(const char *message, char *out, size_t len)
 
 int mf_write_run_summary(const mf_app *app, int status)
 {
+    const mf_sim *sim0 = &app->sim;
+    /* Collective: the particles of every rank; rank 0 writes the file. */
+    int64_t particles = sim0->p ? (int64_t)sim0->p->n_owned : 0;
+    mf_parallel_sum_i64(sim0->par, &particles, 1);
+    if (!mf_parallel_is_root(sim0->par))
+        return 0;
     char dir[4200], path[4300], tmp[4400], criterion[64];
     snprintf(dir, sizeof dir, "%s/output", app->cs.dir);
     MF_CALL(mf_mkdir(dir));
@@ -60,7 +66,8 @@ int mf_write_run_summary(const mf_app *app, int status)
     fprintf(f, "\";\n");
     fprintf(f, "solver              %s;\n", app->solver.info ? app->solver.info->name : "none");
     fprintf(f, "particleSpacing     %.10g;\n", sim->l0);
-    fprintf(f, "particles           %zu;\n", sim->p ? sim->p->n : 0);
+    fprintf(f, "particles           %lld;\n", (long long)particles);
+    fprintf(f, "nProcs              %d;\n", mf_parallel_size(sim->par));
     fprintf(f, "time                %.10g;\n", sim->time);
     fprintf(f, "endTime             %.10g;\n", sim->end_time);
     fprintf(f, "steps               %ld;\n", app->run.steps);

@@ -202,11 +202,19 @@ int mf_app_setup(mf_app *app)
 {
     mf_sim *sim = &app->sim;
     mf_log_init(&app->log, stdout, app->opt.log_level);
+    if (mf_parallel_world_rank() != 0)
+        app->log.out = NULL; /* rank 0 writes the log */
+    if (mf_parallel_world_size() > 1)
+        app->log.progress = false; /* mpirun hands rank 0 a terminal even into a file */
     sim->log = &app->log;
     sim->reg = app->reg;
     MF_CALL(mf_neighbours_create(&sim->neighbours));
     MF_CALL(mf_case_read(app->opt.case_dir, &app->cs));
-    MF_CALL(mf_app_check_output(app));
+    MF_CALL(mf_app_create_parallel(app, app->cs.resolved));
+    /* One rank looks at (and with -overwrite clears) output/: the others
+     * would race it. */
+    MF_CALL(mf_parallel_agree(app->sim.par,
+                              mf_parallel_is_root(app->sim.par) ? mf_app_check_output(app) : 0));
     MF_CALL(mf_app_load_case_libs(app));
     const mf_control *c = &app->cs.control;
     sim->time = c->start_time;
@@ -292,6 +300,8 @@ void mf_app_teardown(mf_app *app)
     mf_particles_destroy(app->sim.p);
     mf_neighbours_destroy(app->sim.neighbours);
     app->sim.neighbours = NULL;
+    mf_parallel_destroy(app->sim.par);
+    app->sim.par = NULL;
     mf_case_free(&app->cs);
 }
 
@@ -300,11 +310,19 @@ void mf_app_summary(const mf_app *app)
     const mf_sim *sim = &app->sim;
     size_t counts[MF_NKINDS];
     mf_particles_count_kinds(sim->p, counts);
-    printf("\nCase %s: %d-D, particle spacing l0 = %g m\n", app->cs.dir, sim->dim, sim->l0);
-    printf("Particles: %zu in all\n", sim->p->n);
+    int64_t total[MF_NKINDS + 1] = {0};
     for (int k = 0; k < MF_NKINDS; k++)
-        if (counts[k])
-            printf("    %-8s %zu\n", mf_particle_kind_name(k), counts[k]);
+        total[MF_NKINDS] += total[k] = (int64_t)counts[k];
+    mf_parallel_sum_i64(sim->par, total, MF_NKINDS + 1); /* over the ranks */
+    double memory[2] = {mf_particles_memory(sim->p) / 1048576.0, mf_peak_memory() / 1048576.0};
+    mf_parallel_max(sim->par, memory, 2);
+    if (!mf_parallel_is_root(sim->par))
+        return;
+    printf("\nCase %s: %d-D, particle spacing l0 = %g m\n", app->cs.dir, sim->dim, sim->l0);
+    printf("Particles: %lld in all\n", (long long)total[MF_NKINDS]);
+    for (int k = 0; k < MF_NKINDS; k++)
+        if (total[k])
+            printf("    %-8s %lld\n", mf_particle_kind_name(k), (long long)total[k]);
     printf("Fluids:\n");
     for (int k = 0; k < sim->nfluids; k++)
         printf("    %-12s rho = %g kg/m^3, nu = %g m^2/s, sigma = %g N/m\n", sim->fluid[k].name,
@@ -316,8 +334,8 @@ void mf_app_summary(const mf_app *app)
     for (int k = 0; k < sim->nscalars; k++)
         printf("Transported scalar: %s\n", sim->scalar_name[k]);
     printf("Solver %s; time %g to %g s\n", app->solver.info->name, sim->time, sim->end_time);
-    printf("Memory: particles %.2f MB; peak resident %.1f MB\n",
-           mf_particles_memory(sim->p) / 1048576.0, mf_peak_memory() / 1048576.0);
+    printf("Memory: particles %.2f MB; peak resident %.1f MB%s\n", memory[0], memory[1],
+           sim->par ? " (the largest rank)" : "");
     const mf_scene_budget *b = &app->budget;
     if (b->bytes_per_particle > 0)
         printf("Memory estimate: %.3g particles x %.0f bytes = %.3g GB of maxMemory %.3g GB (%s)\n",

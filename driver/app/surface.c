@@ -12,7 +12,12 @@
  *
  * -time takes OpenFOAM's forms: a time (the nearest snapshot), a list
  * "0.1,0.2", or a range "0.1:0.5", ":0.5", "0.5:". Without -time or
- * -latestTime every snapshot is done. */
+ * -latestTime every snapshot is done.
+ *
+ * `mpirun -np N mpsflow surface -parallel ...` spreads the frames over the
+ * ranks: rank r takes the r-th of N consecutive runs of frames (each run
+ * warm-starts from its own previous frame, its first frame starts cold),
+ * and rank 0 writes the index once every frame is written. */
 #include <errno.h>
 #include <math.h>
 #include <mpi.h>
@@ -39,6 +44,7 @@ typedef struct surface_opts {
     const char *method;
     const char *libs;
     int log_level;
+    bool parallel;
 } surface_opts;
 
 static void surface_usage(FILE *f)
@@ -59,6 +65,7 @@ static void surface_usage(FILE *f)
             "  -method NAME      levelSet (eqs. 29-32) or blobby (fast preview), overriding\n"
             "                    system/surfaceDict\n"
             "  -libs '(...)'     plugin libraries to load\n"
+            "  -parallel         under mpirun -np N: the frames spread over the N ranks\n"
             "  -quiet, -verbose  less or more log\n"
             "  -help             this text\n");
 }
@@ -66,13 +73,15 @@ static void surface_usage(FILE *f)
 static int parse(int argc, char **argv, int first, surface_opts *o)
 {
     static const char *const known[] = {"-case", "-time", "-latestTime", "-method", "-libs",
-                                        "-quiet", "-verbose", "-help"};
+                                        "-quiet", "-verbose", "-help", "-parallel"};
     for (int i = first; i < argc; i++) {
         const char *a = argv[i];
         if (!strcmp(a, "-help") || !strcmp(a, "--help") || !strcmp(a, "-h"))
             return 1;
         if (!strcmp(a, "-latestTime")) {
             o->latest = true;
+        } else if (!strcmp(a, "-parallel")) {
+            o->parallel = true;
         } else if (!strcmp(a, "-quiet")) {
             o->log_level = MF_LOG_QUIET;
         } else if (!strcmp(a, "-verbose")) {
@@ -163,13 +172,24 @@ static int run_surface(const surface_opts *o, mf_registry *reg, mf_log *log)
     snprintf(out_dir, sizeof out_dir, "%s/postProcessing/surface", cd);
     if (rc == 0)
         rc = mf_mkdir(out_dir);
-    if (rc == 0)
+    /* This rank's run of the selected frames: [first, last) of the nsel. */
+    int rank = 0, nranks = 1;
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    MPI_Comm_size(MPI_COMM_WORLD, &nranks);
+    size_t nsel = 0;
+    for (size_t k = 0; k < n; k++)
+        nsel += sel && sel[k];
+    const size_t first = nsel * (size_t)rank / (size_t)nranks,
+                 last = nsel * (size_t)(rank + 1) / (size_t)nranks;
+    if (rc == 0 && rank == 0)
         rc = write_resolved(out_dir, resolved);
     const mf_surface_ops *ops = rc == 0 ? (const mf_surface_ops *)m.info : NULL;
     int frames = 0, skipped = 0;
     double t_all = mf_wall_seconds();
-    for (size_t k = 0; k < n && rc == 0; k++) {
+    for (size_t k = 0, kth = 0; k < n && rc == 0; k++) {
         if (!sel[k])
+            continue;
+        if (kth++ < first || kth > last)
             continue;
         mf_snapshot_path(cd, idx[k], path, sizeof path);
         mf_sim sim;
@@ -196,8 +216,10 @@ static int run_surface(const surface_opts *o, mf_registry *reg, mf_log *log)
                 rc = MF_ERROR(rc, "%s: %s", path, mf_error_message());
         }
         if (rc == 0)
-            rc = mf_mesh_write_frame(out_dir, "surface", idx[k], &mesh, s.write_ply,
-                                     s.write_obj);
+            rc = mf_mesh_write_frame_files(out_dir, "surface", idx[k], &mesh, s.write_ply,
+                                           s.write_obj);
+        if (rc == 0 && nranks == 1)
+            rc = mf_mesh_write_xdmf_index(out_dir, "surface");
         if (rc == 0) {
             frames++;
             mf_log_printf(log, MF_LOG_NORMAL,
@@ -206,11 +228,22 @@ static int run_surface(const surface_opts *o, mf_registry *reg, mf_log *log)
         }
         mf_particles_destroy(sim.p);
     }
+    if (nranks > 1) {
+        /* Every rank's frames are written: rank 0 indexes them. */
+        int any = rc != 0;
+        MPI_Allreduce(MPI_IN_PLACE, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+        MPI_Allreduce(MPI_IN_PLACE, &frames, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
+        if (any && rc == 0)
+            rc = MF_ERROR(MF_ERR_INPUT, "surface: another rank failed (see its message)");
+        if (rc == 0 && rank == 0)
+            rc = mf_mesh_write_xdmf_index(out_dir, "surface");
+    }
     if (rc == 0)
         mf_log_printf(log, MF_LOG_QUIET,
                       "\nsurface (%s): %d frames (%d snapshot(s) without fluid skipped) in "
-                      "%.2f s, peak memory %.1f MB; ParaView: open %s/surface.xdmf\nEnd\n",
+                      "%.2f s%s, peak memory %.1f MB; ParaView: open %s/surface.xdmf\nEnd\n",
                       s.method, frames, skipped, mf_wall_seconds() - t_all,
+                      nranks > 1 ? " (spread over the ranks)" : "",
                       mf_peak_memory() / 1048576.0, out_dir);
     surface_close(&m);
     mf_mesh_free(&mesh);
@@ -236,9 +269,19 @@ int mf_main_surface(int argc, char **argv, int first)
     }
     /* HDF5 is Debian's MPI build: start MPI as the other commands do. */
     MPI_Init(&argc, &argv);
+    mf_options mo = {.parallel = o.parallel};
+    rc = mf_app_check_parallel(&mo, argc, argv);
+    if (rc != 0) {
+        if (mf_parallel_world_rank() == 0)
+            mf_error_print(stderr);
+        MPI_Finalize();
+        return 2;
+    }
     mf_log log;
     mf_log_init(&log, stdout, o.log_level);
     log.progress = false;
+    if (mf_parallel_world_rank() != 0)
+        log.out = NULL; /* rank 0 writes the log */
     mf_registry *reg = NULL;
     rc = mf_registry_create(&reg);
     if (rc == 0)

@@ -75,9 +75,35 @@ static int fo_execute(void *data, const mf_sim *sim)
     return 0;
 }
 
+static int write_frame(surface_fo *d, const mf_sim *sim);
+
+/* On several ranks the whole fluid is gathered on rank 0, which makes and
+ * writes the frame (the surface is one field over all the particles; the
+ * frames of a run are few, the `surface -parallel` command spreads a
+ * case's frames over ranks instead). */
 static int fo_write(void *data, const mf_sim *sim)
 {
     surface_fo *d = data;
+    if (!sim->par)
+        return write_frame(d, sim);
+    mf_particles *all = NULL;
+    MF_CALL(mf_parallel_gather(sim->par, sim->p, 0, &all));
+    int rc = 0;
+    if (mf_parallel_is_root(sim->par)) {
+        mf_sim whole = *sim;
+        whole.p = all;
+        whole.par = NULL;
+        whole.halo = NULL;
+        rc = write_frame(d, &whole);
+        mf_particles_destroy(all);
+    } else {
+        d->next_index++; /* the same numbering on every rank */
+    }
+    return rc;
+}
+
+static int write_frame(surface_fo *d, const mf_sim *sim)
+{
     const mf_surface_ops *ops = (const mf_surface_ops *)d->m.info;
     size_t counts[MF_NKINDS];
     mf_particles_count_kinds(sim->p, counts);

@@ -33,6 +33,7 @@ typedef struct hdf5_writer {
     int next_index;       /* index of the next snapshot written */
     mf_xdmf_index xdmf;   /* the readable snapshots of the folder */
     int *written;         /* indices this writer wrote, oldest first (purgeWrite) */
+    bool root;            /* rank 0 of a -parallel run (or the serial run): writes the index */
     size_t nwritten, capwritten;
 } hdf5_writer;
 
@@ -52,6 +53,7 @@ static int hdf5_create(const void *settings, const char *case_dir, void **data)
     if (!w)
         return MF_ERROR(MF_ERR_MEMORY, "hdf5 writer: out of memory");
     w->compression = (int)s->compression;
+    w->root = true;
     int rc = 0;
     if (strlen(case_dir) >= sizeof w->case_dir) {
         rc = MF_ERROR(MF_ERR_INPUT, "case path too long: %s", case_dir);
@@ -91,6 +93,9 @@ static int hdf5_write(void *data, const mf_sim *sim, const mf_dict *params)
         w->capwritten = cap;
     }
     w->written[w->nwritten++] = index;
+    w->root = mf_parallel_is_root(sim->par);
+    if (!w->root)
+        return 0; /* one index file, written by rank 0 */
     mf_xdmf_snap s;
     MF_CALL(mf_xdmf_describe(w->output_dir, index, &s));
     MF_CALL(mf_xdmf_index_add(&w->xdmf, &s));
@@ -165,13 +170,18 @@ static int hdf5_purge(void *data, long keep)
             continue;
         }
         MF_CALL(mf_h5_snapshot_path(w->output_dir, index, path, sizeof path));
+        if (!w->root) { /* rank 0 removes the files of a -parallel run */
+            excess--;
+            continue;
+        }
         if (unlink(path) != 0 && errno != ENOENT)
             return MF_ERROR(MF_ERR_IO, "purgeWrite: cannot remove %s (%s)", path, strerror(errno));
         mf_xdmf_index_remove(&w->xdmf, index);
         excess--;
     }
     w->nwritten = m;
-    MF_CALL(mf_xdmf_index_write(&w->xdmf, w->output_dir));
+    if (w->root)
+        MF_CALL(mf_xdmf_index_write(&w->xdmf, w->output_dir));
     return 0;
 }
 

@@ -1,9 +1,20 @@
 /* hdf5_writer.c: write one snapshot file (layout in mf_hdf5.h).
  *
- * The file is built in memory, written as "<path>.tmp" (by us, not HDF5:
- * build_image), synced and renamed: the real name only ever holds a complete
- * file, and a write that fails leaves no HDF5 handle open. Particles are grouped by kind in
- * storage order; StorageIndex records where each came from. */
+ * On one rank the file is built in memory, written as "<path>.tmp" (by us,
+ * not HDF5: build_image), synced and renamed: the real name only ever holds a
+ * complete file, and a write that fails (a full disk) leaves no HDF5 handle
+ * open. Particles are grouped by kind in storage order; StorageIndex
+ * records where each came from.
+ *
+ * On several ranks (a -parallel run) the file is the same one file, written
+ * collectively through MPI-IO (parallel HDF5: write_collective): every rank
+ * writes its owned particles of each kind as one block of rows, blocks in
+ * rank order (the global storage order: rank 0's particles, then rank 1's,
+ * ...), so readers see one snapshot as from a serial run, with each
+ * particle's id. The header carries the totals; rank 0 commits the finished
+ * file. A disk that fills while HDF5 flushes the file fails its close there
+ * (said, the .tmp removed); the in-memory path's guarantee that nothing of
+ * HDF5 stays open after such a failure holds on one rank only. */
 #include <errno.h>
 #include <fcntl.h>
 #include <stdio.h>
@@ -14,6 +25,7 @@
 #include "hdf5_internal.h"
 #include "mf_error.h"
 #include "mf_hdf5.h"
+#include "mf_parallel_mpi.h"
 
 /* Rows per chunk when compressing: 16k rows of 3 doubles is 384 KiB, inside
  * HDF5's default 1 MiB chunk cache. */
@@ -24,8 +36,12 @@ typedef struct snap_writer {
     hid_t file;
     int compression;
     const mf_particles *p;
+    const mf_parallel *par; /* NULL: one rank writes alone */
     size_t *index;      /* particles of the kind being written */
-    size_t count;
+    size_t count;       /* this rank's rows of that kind */
+    hsize_t rows;       /* all ranks' rows of that kind */
+    hsize_t first;      /* this rank's first row of that kind */
+    int64_t storage0;   /* global storage index of this rank's first particle */
     void *buf;          /* gather buffer: count * max components * 8 bytes */
 } snap_writer;
 
@@ -38,7 +54,8 @@ static int write_header(const snap_writer *w, const mf_sim *sim,
     if (g < 0)
         return MF_ERROR(MF_ERR_IO, "%s: cannot create the group (%s)", what,
                         mf_h5_error_detail(detail, sizeof detail));
-    const int64_t step = sim->step, next_id = w->p->next_id;
+    int64_t step = sim->step, next_id = w->p->next_id;
+    mf_parallel_max_i64(w->par, &next_id, 1); /* the smallest id no rank has used */
     const int dim = w->p->dim, one = 1;
     int rc = 0;
     MF_CALL_GOTO(rc, mf_h5_attr_write(g, "Time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 0, &sim->time, what), done);
@@ -48,7 +65,7 @@ static int write_header(const snap_writer *w, const mf_sim *sim,
     MF_CALL_GOTO(rc, mf_h5_attr_write(g, "Dimension", H5T_STD_I32LE, H5T_NATIVE_INT, 0, &dim, what), done);
     MF_CALL_GOTO(rc, mf_h5_attr_write(g, "ParticleSpacing", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 0, &sim->l0, what), done);
     MF_CALL_GOTO(rc, mf_h5_attr_write(g, "NumPart_ThisFile", H5T_STD_I64LE, H5T_NATIVE_INT64, MF_NKINDS, counts, what), done);
-    /* One file per snapshot (and one rank) for now: the totals are the same. */
+    /* One file per snapshot (written by every rank): the totals are the same. */
     MF_CALL_GOTO(rc, mf_h5_attr_write(g, "NumPart_Total", H5T_STD_I64LE, H5T_NATIVE_INT64, MF_NKINDS, counts, what), done);
     MF_CALL_GOTO(rc, mf_h5_attr_write(g, "NextId", H5T_STD_I64LE, H5T_NATIVE_INT64, 0, &next_id, what), done);
     MF_CALL_GOTO(rc, mf_h5_attr_write(g, "NumFilesPerSnapshot", H5T_STD_I32LE, H5T_NATIVE_INT, 0, &one, what), done);
@@ -83,11 +100,11 @@ static int write_dataset(const snap_writer *w, hid_t group, const char *group_na
 {
     char what[MF_H5_PATH_MAX], detail[256];
     snprintf(what, sizeof what, "%s:/%s/%s", w->path, group_name, name);
-    hsize_t dims[2] = {w->count, (hsize_t)ncomp};
+    hsize_t dims[2] = {w->rows, (hsize_t)ncomp};
     int rank = ncomp == 1 ? 1 : 2;
     hid_t space = H5Screate_simple(rank, dims, NULL);
     hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
-    hid_t dset = H5I_INVALID_HID;
+    hid_t dset = H5I_INVALID_HID, mem = H5I_INVALID_HID, dxpl = H5P_DEFAULT;
     int rc = 0;
     if (space < 0 || dcpl < 0) {
         rc = MF_ERROR(MF_ERR_IO, "%s: cannot create the dataspace (%s)", what,
@@ -95,7 +112,7 @@ static int write_dataset(const snap_writer *w, hid_t group, const char *group_na
         goto done;
     }
     if (w->compression > 0) {
-        hsize_t chunk[2] = {w->count < CHUNK_ROWS ? w->count : CHUNK_ROWS, (hsize_t)ncomp};
+        hsize_t chunk[2] = {w->rows < CHUNK_ROWS ? w->rows : CHUNK_ROWS, (hsize_t)ncomp};
         /* Shuffle groups the bytes of equal significance: gzip then finds
          * the repeated exponents of neighbouring doubles. Both lossless. */
         if (H5Pset_chunk(dcpl, rank, chunk) < 0 || H5Pset_shuffle(dcpl) < 0 ||
@@ -106,13 +123,34 @@ static int write_dataset(const snap_writer *w, hid_t group, const char *group_na
         }
     }
     dset = H5Dcreate2(group, name, file_type, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
-    if (dset < 0 || H5Dwrite(dset, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, w->buf) < 0) {
+    herr_t wrc = dset < 0 ? -1 : 0;
+    if (wrc == 0 && !w->par) {
+        wrc = H5Dwrite(dset, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, w->buf);
+    } else if (wrc == 0) {
+        /* This rank's block of rows; every rank takes part (an empty
+         * selection on a rank with none), as a collective write must. */
+        hsize_t start[2] = {w->first, 0}, count[2] = {w->count, (hsize_t)ncomp};
+        mem = H5Screate_simple(rank, count, NULL);
+        dxpl = H5Pcreate(H5P_DATASET_XFER);
+        wrc = mem < 0 || dxpl < 0 || H5Pset_dxpl_mpio(dxpl, H5FD_MPIO_COLLECTIVE) < 0 ? -1 : 0;
+        if (wrc == 0)
+            wrc = w->count ? H5Sselect_hyperslab(space, H5S_SELECT_SET, start, NULL, count, NULL)
+                           : H5Sselect_none(space);
+        if (wrc == 0 && !w->count)
+            wrc = H5Sselect_none(mem);
+        if (wrc == 0)
+            wrc = H5Dwrite(dset, mem_type, mem, space, dxpl, w->buf);
+    }
+    if (wrc < 0) {
         rc = MF_ERROR(MF_ERR_IO, "%s: cannot write the dataset (%s)", what,
                       mf_h5_error_detail(detail, sizeof detail));
         goto done;
     }
     rc = mf_h5_attr_write_string(dset, "Units", mf_h5_unit(name), what);
 done:
+    if (dxpl != H5P_DEFAULT)
+        mf_h5_close(&dxpl);
+    mf_h5_close(&mem);
     mf_h5_close(&dset);
     mf_h5_close(&dcpl);
     mf_h5_close(&space);
@@ -162,6 +200,7 @@ static int write_kind(snap_writer *w, int kind)
     for (size_t i = 0; i < p->n_owned; i++)
         if (p->kind[i] == kind)
             w->index[w->count++] = i;
+    w->first = (hsize_t)mf_parallel_exscan(w->par, (int64_t)w->count);
 
     hid_t g = H5Gcreate2(w->file, group_name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
     if (g < 0)
@@ -179,7 +218,7 @@ static int write_kind(snap_writer *w, int kind)
         ids[k] = p->id[w->index[k]];
     MF_CALL_GOTO(rc, write_dataset(w, g, group_name, "ParticleIDs", 1, H5T_STD_I64LE, H5T_NATIVE_INT64), done);
     for (size_t k = 0; k < w->count; k++)
-        ids[k] = (int64_t)w->index[k];
+        ids[k] = w->storage0 + (int64_t)w->index[k];
     MF_CALL_GOTO(rc, write_dataset(w, g, group_name, "StorageIndex", 1, H5T_STD_I64LE, H5T_NATIVE_INT64), done);
     MF_CALL_GOTO(rc, write_viewer_datasets(w, g, group_name, kind), done);
 
@@ -263,13 +302,29 @@ static void close_all(hid_t *file)
     mf_h5_close(file);
 }
 
-/* The snapshot is built in memory (HDF5's core driver, no backing store)
- * and written to the file by us in one go: HDF5 itself never writes to the
- * disk, so a full disk (or any write error) is a failed write() of ours,
- * reported with its errno, after which nothing of HDF5 is left open. With
- * HDF5 writing the file itself, a failure while it flushed left the file
- * open inside the library, and closing it at exit crashed. The cost is the
- * file's image in memory while it is written (twice: HDF5's and the copy). */
+/* The header, the parameters and every kind's datasets into w->file. */
+static int write_contents(snap_writer *w, const mf_sim *sim, const mf_dict *params,
+                          const int64_t counts[MF_NKINDS])
+{
+    MF_CALL(write_header(w, sim, counts));
+    if (params)
+        MF_CALL(write_parameters(w, params));
+    for (int kind = 0; kind < MF_NKINDS; kind++)
+        if (counts[kind] > 0) {
+            w->rows = (hsize_t)counts[kind];
+            MF_CALL(write_kind(w, kind));
+        }
+    return 0;
+}
+
+/* One rank: the snapshot is built in memory (HDF5's core driver, no
+ * backing store) and written to the file by us in one go: HDF5 itself never
+ * writes to the disk, so a full disk (or any write error) is a failed
+ * write() of ours, reported with its errno, after which nothing of HDF5 is
+ * left open. With HDF5 writing the file itself, a failure while it flushed
+ * left the file open inside the library, and closing it at exit crashed.
+ * The cost is the file's image in memory while it is written (twice:
+ * HDF5's and the copy). */
 static int build_image(snap_writer *w, const mf_sim *sim, const mf_dict *params,
                        const int64_t counts[MF_NKINDS], void **image, size_t *size)
 {
@@ -286,12 +341,7 @@ static int build_image(snap_writer *w, const mf_sim *sim, const mf_dict *params,
     if (w->file < 0)
         return MF_ERROR(MF_ERR_IO, "cannot create %s in memory (%s)", w->path, detail);
     int rc = 0;
-    MF_CALL_GOTO(rc, write_header(w, sim, counts), done);
-    if (params)
-        MF_CALL_GOTO(rc, write_parameters(w, params), done);
-    for (int kind = 0; kind < MF_NKINDS; kind++)
-        if (counts[kind] > 0)
-            MF_CALL_GOTO(rc, write_kind(w, kind), done);
+    MF_CALL_GOTO(rc, write_contents(w, sim, params, counts), done);
     /* Flushed first: the image must hold the metadata still in HDF5's caches. */
     ssize_t n = H5Fflush(w->file, H5F_SCOPE_GLOBAL) < 0 ? -1 : H5Fget_file_image(w->file, NULL, 0);
     if (n > 0 && (*image = malloc((size_t)n)) != NULL && H5Fget_file_image(w->file, *image, (size_t)n) == n) {
@@ -306,6 +356,34 @@ static int build_image(snap_writer *w, const mf_sim *sim, const mf_dict *params,
 done:
     close_all(&w->file);
     return rc;
+}
+
+/* Several ranks: tmp written by all of them through MPI-IO, each its block
+ * of rows (collective calls throughout). */
+static int write_collective(snap_writer *w, const char *tmp, const mf_sim *sim,
+                            const mf_dict *params, const int64_t counts[MF_NKINDS])
+{
+    char detail[256];
+    hid_t fapl = mf_h5_fapl();
+    if (fapl >= 0 && H5Pset_fapl_mpio(fapl, mf_parallel_comm(w->par), MPI_INFO_NULL) < 0)
+        mf_h5_close(&fapl);
+    w->file = fapl < 0 ? H5I_INVALID_HID : H5Fcreate(tmp, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+    mf_h5_error_detail(detail, sizeof detail);
+    mf_h5_close(&fapl);
+    if (w->file < 0)
+        return MF_ERROR(MF_ERR_IO, "cannot create %s (%s)", tmp, detail);
+    int rc = write_contents(w, sim, params, counts);
+    if (rc != 0) {
+        close_all(&w->file);
+        return mf_error_trace(rc, __FILE__, __LINE__, __func__);
+    }
+    /* Closing flushes: a full disk shows up here. */
+    herr_t closed = H5Fclose(w->file);
+    w->file = H5I_INVALID_HID;
+    if (closed < 0)
+        return MF_ERROR(MF_ERR_IO, "cannot finish writing %s (%s)", tmp,
+                        mf_h5_error_detail(detail, sizeof detail));
+    return 0;
 }
 
 /* size bytes to tmp, synced: a short write or a failed sync removes tmp. */
@@ -349,39 +427,52 @@ int mf_hdf5_write_snapshot(const char *path, const mf_sim *sim, const mf_dict *p
                         compression);
     int64_t counts[MF_NKINDS];
     int max_ncomp = 3;
-    MF_CALL(check_particles(sim, path, counts, &max_ncomp));
+    MF_CALL(mf_parallel_agree(sim->par, check_particles(sim, path, counts, &max_ncomp)));
+    mf_parallel_sum_i64(sim->par, counts, MF_NKINDS); /* the totals of all ranks */
     char tmp[MF_H5_PATH_MAX];
     int len = snprintf(tmp, sizeof tmp, "%s.tmp", path);
     if (len < 0 || (size_t)len >= sizeof tmp)
         return MF_ERROR(MF_ERR_INPUT, "snapshot path too long: %s", path);
 
     const mf_particles *p = sim->p;
-    snap_writer w = {.path = path, .file = H5I_INVALID_HID, .compression = compression, .p = p};
+    snap_writer w = {.path = path, .file = H5I_INVALID_HID, .compression = compression, .p = p,
+                     .par = sim->par};
+    w.storage0 = mf_parallel_exscan(sim->par, (int64_t)p->n_owned);
     size_t n = p->n_owned > 0 ? p->n_owned : 1;
     w.index = malloc(n * sizeof *w.index);
     w.buf = malloc(n * (size_t)max_ncomp * sizeof(double));
-    if (!w.index || !w.buf) {
+    int rc = !w.index || !w.buf
+                 ? MF_ERROR(MF_ERR_MEMORY, "%s: out of memory for %zu particles", path, n)
+                 : 0;
+    rc = mf_parallel_agree(sim->par, rc);
+    if (rc != 0) {
         free(w.index);
         free(w.buf);
-        return MF_ERROR(MF_ERR_MEMORY, "%s: out of memory for %zu particles", path, n);
+        return mf_error_trace(rc, __FILE__, __LINE__, __func__);
     }
 
     mf_h5_quiet quiet;
     mf_h5_quiet_begin(&quiet);
     void *image = NULL;
     size_t size = 0;
-    int rc = build_image(&w, sim, params, counts, &image, &size);
+    rc = sim->par ? write_collective(&w, tmp, sim, params, counts)
+                  : build_image(&w, sim, params, counts, &image, &size);
     mf_h5_quiet_end(&quiet);
     free(w.index);
     free(w.buf);
-    if (rc == 0)
+    if (rc == 0 && !sim->par)
         rc = write_image(tmp, image, size);
     free(image);
-    if (rc == 0)
+    /* Every rank has closed the file (a collective close) before rank 0
+     * renames it. */
+    rc = mf_parallel_agree(sim->par, rc);
+    const bool root = mf_parallel_is_root(sim->par);
+    if (rc == 0 && root)
         rc = mf_h5_commit(tmp, path);
-    if (rc != 0) {
+    if (rc != 0 && root)
         unlink(tmp); /* nothing half-written is left behind */
+    rc = mf_parallel_agree(sim->par, rc);
+    if (rc != 0)
         return mf_error_trace(rc, __FILE__, __LINE__, __func__);
-    }
     return 0;
 }

@@ -457,6 +457,14 @@ int mf_mesh_write_xdmf_index(const char *dir, const char *prefix)
 int mf_mesh_write_frame(const char *dir, const char *prefix, int index, const mf_mesh *m,
                         bool ply, bool obj)
 {
+    MF_CALL(mf_mesh_write_frame_files(dir, prefix, index, m, ply, obj));
+    MF_CALL(mf_mesh_write_xdmf_index(dir, prefix));
+    return 0;
+}
+
+int mf_mesh_write_frame_files(const char *dir, const char *prefix, int index, const mf_mesh *m,
+                              bool ply, bool obj)
+{
     MF_CALL(mf_mkdir_p(dir));
     char path[PATH_MAX_LEN];
     if (ply) {
@@ -469,6 +477,5 @@ int mf_mesh_write_frame(const char *dir, const char *prefix, int index, const mf
     }
     snprintf(path, sizeof path, "%s/%s_%06d.h5", dir, prefix, index);
     MF_CALL(mf_mesh_write_h5(path, m));
-    MF_CALL(mf_mesh_write_xdmf_index(dir, prefix));
     return 0;
 }

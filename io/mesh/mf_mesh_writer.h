@@ -39,6 +39,9 @@ int mf_mesh_read_ply(const char *path, mf_mesh *m);
  * rebuild the index <dir>/<prefix>.xdmf. Creates dir if needed. */
 int mf_mesh_write_frame(const char *dir, const char *prefix, int index, const mf_mesh *m,
                         bool ply, bool obj);
+/* The frame's files only (several ranks writing frames: one indexes them). */
+int mf_mesh_write_frame_files(const char *dir, const char *prefix, int index, const mf_mesh *m,
+                              bool ply, bool obj);
 
 /* Rebuild <dir>/<prefix>.xdmf from the <prefix>_NNNNNN.h5 files in dir,
  * in time order (a frame whose time repeats an earlier one of a higher index

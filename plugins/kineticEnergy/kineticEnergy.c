@@ -6,7 +6,8 @@
  *   functions { energy { type kineticEnergy; libs ("libkineticEnergy.so"); } }
  *
  * Writes postProcessing/<name>/kineticEnergy.dat: time, E = sum m |u|^2 / 2
- * per unit mass (m = rho l0^d), max speed. */
+ * per unit mass (m = rho l0^d), max speed. On several ranks (-parallel) the
+ * sums are reduced over the ranks and rank 0 writes the file. */
 #include <errno.h>
 #include <math.h>
 #include <stddef.h>
@@ -17,6 +18,7 @@
 #include "mf_error.h"
 #include "mf_fs.h"
 #include "mf_modules.h"
+#include "mf_sim.h"
 
 typedef struct ke_settings {
     long interval; /* every N steps */
@@ -34,12 +36,19 @@ static const mf_param ke_params[] = {
 
 static int ke_create(const void *settings, const mf_sim *sim, const char *out_dir, void **data)
 {
-    (void)sim;
-    MF_CALL(mf_mkdir_p(out_dir));
     ke_data *d = calloc(1, sizeof *d);
     if (!d)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory");
     d->s = *(const ke_settings *)settings;
+    if (!mf_parallel_is_root(sim->par)) { /* rank 0 writes the file */
+        *data = d;
+        return 0;
+    }
+    int rc = mf_mkdir_p(out_dir);
+    if (rc != 0) {
+        free(d);
+        return rc;
+    }
     char path[4600];
     snprintf(path, sizeof path, "%s/kineticEnergy.dat", out_dir);
     d->out = fopen(path, "a");
@@ -69,7 +78,10 @@ static int ke_execute(void *data, const mf_sim *sim)
         if (u2 > umax * umax)
             umax = sqrt(u2);
     }
-    fprintf(d->out, "%.10g %.10g %.10g\n", sim->time, e, umax);
+    mf_parallel_sum(sim->par, &e, 1);
+    mf_parallel_max(sim->par, &umax, 1);
+    if (d->out)
+        fprintf(d->out, "%.10g %.10g %.10g\n", sim->time, e, umax);
     return 0;
 }
 

@@ -75,13 +75,22 @@ int st_accumulate(void *data, const mf_sim *sim, double *acc)
     st_ctx c = {.d = d, .p = p, .fid = ff >= 0 ? mf_particles_fi(p, ff) : NULL, .v = &v,
                 .acc = acc, .accel_out = accel_out, .kappa_out = kappa_out, .sim = sim};
     st_count_neighbours(&c);
+    MF_CALL(st_sync(sim, d->n1, sizeof *d->n1));
+    MF_CALL(st_sync(sim, d->nall, sizeof *d->nall));
     c.n_full = st_measured_full_count(&c);
     st_find_interface(&c);
+    MF_CALL(st_sync(sim, d->nrm, 3 * sizeof *d->nrm));
+    MF_CALL(st_sync(sim, d->fdir, 3 * sizeof *d->fdir));
+    MF_CALL(st_sync(sim, d->kappa, sizeof *d->kappa));
     if (d->normal) {
         st_smooth_normals(&c);
+        MF_CALL(st_sync(sim, d->nrm, 3 * sizeof *d->nrm));
+        MF_CALL(st_sync(sim, d->fdir, 3 * sizeof *d->fdir));
         st_normal_divergence(&c);
+        MF_CALL(st_sync(sim, d->kappa, sizeof *d->kappa));
     }
-    const double *kappa = st_smooth_curvature(&c);
+    const double *kappa = NULL;
+    MF_CALL(st_smooth_curvature(&c, &kappa));
     /* sigma kappa delta n. An unlike pair (i in x, j in y) adds
      * -sigma_xy kappa_ij C phi r_hat_ij to both i and j, kappa_ij the mean of
      * the curvature seen from x and minus the one seen from y: the two sides

@@ -3,6 +3,7 @@
 #include <math.h>
 
 #include "surface_tension.h"
+#include "mf_parallel.h"
 
 /* eqs. 34-35: n^st1 (own fluid, walls included) and the count of every
  * particle within r_st. */
@@ -71,7 +72,9 @@ double st_measured_full_count(st_ctx *c)
             count++;
         }
     }
-    return count ? sum / (double)count : d->n_full;
+    double v[2] = {sum, (double)count}; /* over the ranks */
+    mf_parallel_sum(c->sim->par, v, 2);
+    return v[1] > 0 ? v[0] / v[1] : d->n_full;
 }
 
 /* Interface particles and their curvature (eqs. 36-39); kappa = NAN off the

@@ -46,8 +46,8 @@ static void smooth_row(const void *ctx, size_t i)
  * smoothed). An interface between fluids is not smoothed: there the
  * average over its band of 2 r_st would pull kappa down (0.87 of 1/R on
  * a lattice drop). */
-/* Returns the curvature after the passes (d->kappa or d->kappa_s). */
-const double *st_smooth_curvature(st_ctx *c)
+/* The curvature after the passes (d->kappa or d->kappa_s) in *kappa. */
+int st_smooth_curvature(st_ctx *c, const double **kappa)
 {
     st_data *d = c->d;
     double *kin = d->kappa, *kout = d->kappa_s;
@@ -55,9 +55,11 @@ const double *st_smooth_curvature(st_ctx *c)
         c->kin = kin;
         c->kout = kout;
         mf_pairs_each(c->v, NULL, smooth_row, c);
+        MF_CALL(st_sync(c->sim, kout, sizeof *kout));
         double *t = kin;
         kin = kout;
         kout = t;
     }
-    return kin;
+    *kappa = kin;
+    return 0;
 }

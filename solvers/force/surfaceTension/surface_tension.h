@@ -88,6 +88,8 @@
 #include <stdint.h>
 
 #include "force/forces.h"
+#include "mf_error.h"
+#include "mf_halo.h"
 #include "mf_pairs.h"
 
 typedef struct st_settings {
@@ -185,7 +187,16 @@ void st_find_interface(const st_ctx *c);
 void st_smooth_normals(const st_ctx *c);
 void st_normal_divergence(const st_ctx *c);
 /* st_smooth.c */
-const double *st_smooth_curvature(st_ctx *c);
+int st_smooth_curvature(st_ctx *c, const double **kappa);
+
+/* The copies [n_owned, n) of what a pass computed on the owned particles
+ * (other ranks' particles, periodic images), for the next pass, which reads
+ * its neighbours' values: nothing without copies. */
+static inline int st_sync(const mf_sim *sim, void *values, size_t size)
+{
+    MF_CALL(mf_halo_update(sim->halo, sim->par, sim->p, values, size));
+    return 0;
+}
 /* st_force.c */
 int st_accumulate(void *data, const mf_sim *sim, double *acc);
 /* st_pressure.c */

@@ -42,6 +42,7 @@
 #include <stdint.h>
 
 #include "mf_modules.h"
+#include "mf_halo.h"
 #include "mf_neighbours.h"
 #include "mf_pairs.h"
 #include "solver/mps/mps.h"
@@ -107,6 +108,9 @@ typedef struct mafl_data {
     double q_max;              /* largest q of the last step */
     long q_limited;            /* grid points where |u^a| dt > dr widened the grid */
     double t_lagrangian, t_reconfigure, t_eulerian, t_points;
+    /* Copies of other ranks' points for the reconfiguration, the Eulerian
+     * phase and the point count (a -parallel run; NULL otherwise). */
+    mf_halo *halo;
 } mafl_data;
 
 extern const mf_solver_ops mf_solver_MAFL;
@@ -118,6 +122,11 @@ int mafl_reserve(mafl_data *d, size_t n);
 
 /* mafl_step.c */
 int mafl_step(mafl_data *d, mf_sim *sim, double dt);
+
+/* On several ranks: copies of the other ranks' points within radius into
+ * [n_owned, n) (with the fields the MAFL phases read of a neighbour when
+ * values is set); nothing on one rank. */
+int mafl_copies(mafl_data *d, mf_sim *sim, double radius, bool values);
 
 /* mafl_lagrangian.c: the Lagrangian phase, the MPS module's step. */
 int mafl_lagrangian(mafl_data *d, mf_sim *sim, double dt);

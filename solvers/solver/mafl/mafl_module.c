@@ -54,6 +54,7 @@ static void mafl_destroy_data(mafl_data *d)
     if (d->conv_ops && d->conv.data)
         d->conv_ops->destroy(d->conv.data);
     mf_module_release(&d->conv);
+    mf_halo_destroy(d->halo);
     free(d->pos_l);
     free(d->pos_new);
     free(d->value);
@@ -97,6 +98,12 @@ static int create_data(mafl_data *d, mf_sim *sim, const mf_dict *solver_dict)
             memcpy(d->lattice, &p->pos[3 * i], sizeof d->lattice);
             break;
         }
+    /* On several ranks: the MPS phases' copies carry r^n (the PPE source of
+     * densityReference startOfStep and divergence reads it), and the MAFL
+     * phases have copies of their own. */
+    MF_CALL(mps_halo_add_field(d->mps, d->f_pos_n, MPS_HALO_STAR));
+    if (sim->par)
+        MF_CALL(mf_halo_create(&d->halo));
     /* Inlet and outlet points are computation points that stay in place. */
     if (sim->emitters)
         sim->emitters->fixed_buffers = true;
@@ -139,7 +146,8 @@ static void mafl_destroy(void *data) { mafl_destroy_data(data); }
 static void mafl_report(void *data, const mf_sim *sim, mf_log *log)
 {
     const mafl_data *d = data;
-    (void)sim;
+    double points[2] = {(double)d->total_added, (double)d->total_removed}; /* every rank's */
+    mf_parallel_sum(sim->par, points, 2);
     /* Steps this run took (one explicit phase of the MPS module each);
      * sim->step counts from before a restart. */
     const double steps = d->mps->attempts > 0 ? (double)d->mps->attempts : 1.0;
@@ -150,9 +158,9 @@ static void mafl_report(void *data, const mf_sim *sim, mf_log *log)
                   1e3 * d->t_lagrangian / steps, 1e3 * d->t_reconfigure / steps,
                   1e3 * d->t_eulerian / steps, 1e3 * d->t_points / steps, 1e3 * total / steps);
     mf_log_printf(log, MF_LOG_QUIET,
-                  "MAFL points: added %zu (eq. 22), removed %zu over the run; %ld grid "
-                  "widenings where |u^a| dt > dr\n",
-                  d->total_added, d->total_removed, d->q_limited);
+                  "MAFL points: added %.0f (eq. 22), removed %.0f over the run; %ld grid "
+                  "widenings where |u^a| dt > dr%s\n",
+                  points[0], points[1], d->q_limited, sim->par ? " (on rank 0)" : "");
 }
 
 const mf_solver_ops mf_solver_MAFL = {

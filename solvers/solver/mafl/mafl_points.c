@@ -9,7 +9,15 @@
  *    number-density radius (so inside the fluid, not beyond its surface),
  *    gets a new fluid point. Its values are those of the closest
  *    old point after the Eulerian phase, f^L(r_cl - u^a dt) (eq. 22).
- * New points get fresh ids (mf_particles_add); ids are never reused. */
+ * New points get fresh ids (mf_particles_add); ids are never reused.
+ *
+ * On several ranks each rank decides for its own points, with copies of
+ * the other ranks' points within reach: a pair across ranks is merged by
+ * the owner of the newer point, and a hole is filled by the owner of its
+ * closest point (the nearest, lowest id first, which both ranks find
+ * alike), so no point is added twice. A chain of three points within
+ * removeDistance across a rank boundary may lose one point more than the
+ * serial run, which decides in index order. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -82,7 +90,7 @@ static inline bool merge_point(void *acc, const void *ctx, size_t j, const doubl
 static size_t mark_merges(mafl_data *d, const mf_particles *p, double dmin)
 {
     size_t count = 0;
-    for (size_t i = 0; i < p->n; i++) {
+    for (size_t i = 0; i < p->n_owned; i++) {
         if (p->kind[i] != MF_FLUID)
             continue;
         const merge_ctx c = {d, p, i, dmin};
@@ -120,6 +128,7 @@ typedef struct hole_ctx {
     const mafl_data *d;
     const mf_particles *p;
     double dmin, re;
+    bool by_id; /* equal distances: the lowest id is the closest */
 } hole_ctx;
 
 typedef struct hole_acc {
@@ -146,7 +155,9 @@ static inline bool hole_point(void *acc, const void *ctx, size_t j, const double
         a->best_any = dist;
         a->nearest = j;
     }
-    if (carries_values(c->p->kind[j]) && dist < a->best) {
+    if (carries_values(c->p->kind[j]) &&
+        (dist < a->best ||
+         (c->by_id && dist == a->best && c->p->id[j] < c->p->id[a->closest]))) {
         a->best = dist;
         a->closest = j;
     }
@@ -161,7 +172,8 @@ static inline bool hole_point(void *acc, const void *ctx, size_t j, const double
 static bool is_hole(const mafl_data *d, const mf_particles *p, const double x[3], double l0,
                     double full, size_t *closest, size_t *nearest)
 {
-    const hole_ctx c = {d, p, d->s.hole_distance * l0, d->mps->k_nd.re};
+    /* On several ranks ties are broken alike on every rank (lowest id). */
+    const hole_ctx c = {d, p, d->s.hole_distance * l0, d->mps->k_nd.re, d->halo != NULL};
     hole_acc a = {0, INFINITY, INFINITY, *closest, *nearest, false};
     mf_grid_near(d->grid, x, hole_point, &c, &a);
     *closest = a.closest;
@@ -201,7 +213,7 @@ static int find_holes(mafl_data *d, const mf_sim *sim, hole **out, size_t *nout)
     size_t ncand = 0, cap = 0;
     uint64_t *keys = NULL;
     int rc = 0;
-    for (size_t i = 0; i < p->n && rc == 0; i++) {
+    for (size_t i = 0; i < p->n_owned && rc == 0; i++) {
         if (p->kind[i] != MF_FLUID || d->remove[i] || !(nd[i] < 0.99 * n0))
             continue;
         if (ncand + (size_t)per > cap) {
@@ -235,8 +247,8 @@ static int find_holes(mafl_data *d, const mf_sim *sim, hole **out, size_t *nout)
         double x[3];
         site_position(d, dim, keys[k], l0, x);
         size_t closest = 0, nearest = 0;
-        if (!is_hole(d, p, x, l0, full, &closest, &nearest))
-            continue;
+        if (!is_hole(d, p, x, l0, full, &closest, &nearest) || closest >= p->n_owned)
+            continue; /* (closest beyond n_owned: the other rank's hole) */
         if (d->s.hole_spacing)
             space_from_nearest(p, nearest, l0, x);
         if (nholes == hcap) {
@@ -288,15 +300,19 @@ int mafl_update_points(mafl_data *d, mf_sim *sim)
     double cell = d->mps->k_nd.re;
     if (d->s.hole_distance * l0 > cell)
         cell = d->s.hole_distance * l0;
+    /* Copies reach a site's neighbours: sites lie within sqrt(3) l0 of a
+     * point, their neighbours within the number-density radius. */
+    MF_CALL(mafl_copies(d, sim, cell + 2 * l0, false));
     MF_CALL(mf_neighbours_grid(sim->neighbours, p, cell, &d->grid));
-    const size_t n_old = p->n;
-    memset(d->remove, 0, n_old);
+    const size_t n_old = p->n_owned;
+    memset(d->remove, 0, p->n);
     size_t merged = dmerge > 0 ? mark_merges(d, p, dmerge) : 0;
     hole *holes = NULL;
     size_t nholes = 0;
-    if (d->s.add_points)
-        MF_CALL(find_holes(d, sim, &holes, &nholes));
-    int rc = 0;
+    int rc = d->s.add_points ? find_holes(d, sim, &holes, &nholes) : 0;
+    if (d->halo)
+        mf_halo_drop(d->halo, p); /* before any point is added */
+    MF_CALL(mf_parallel_agree(sim->par, rc));
     for (size_t k = 0; k < nholes && rc == 0; k++)
         rc = add_point(d, sim, &holes[k]);
     free(holes);

@@ -4,6 +4,7 @@
 
 #include "mafl.h"
 #include "mf_error.h"
+#include "mf_halo.h"
 #include "mf_run.h"
 
 /* Keep r^n, u^n and the kinds in fields (the MPS step may reorder the
@@ -64,6 +65,46 @@ static void commit(mafl_data *d, mf_sim *sim)
     }
 }
 
+/* On several ranks, copies of the other ranks' points within `radius`
+ * (positions, velocities, kinds, ids and the fields the MAFL phases read of
+ * a neighbour: kinds before the Lagrangian phase, free-surface flags,
+ * scalars). Nothing on one rank. */
+int mafl_copies(mafl_data *d, mf_sim *sim, double radius, bool values)
+{
+    if (!d->halo)
+        return 0;
+    mf_halo_spec spec = {.radius = radius, .velocities = values};
+    if (values) {
+        spec.field[spec.nfields++] = d->f_kind;
+        spec.field[spec.nfields++] = d->mps->f_flags;
+        for (int k = 0; k < d->nscalars; k++)
+            spec.field[spec.nfields++] = d->f_scalar[k];
+    }
+    MF_CALL(mf_halo_build(d->halo, sim->par, sim->p, &spec));
+    MF_CALL(mafl_reserve(d, sim->p->n));
+    return 0;
+}
+
+/* How far the Eulerian phase reads from a point at r^L: its 1-D grid
+ * reaches two spacings upstream, each spacing dr or |u^a| dt when longer,
+ * and |u^a| dt = |r^L - r^{n+1}| is at most the Lagrangian displacement plus
+ * the reconfiguration's largest shift (0.2 l0); then the disk of eq. 23. */
+static double eulerian_reach(const mafl_data *d, const mf_sim *sim)
+{
+    const mf_particles *p = sim->p;
+    const double *xn = mf_particles_fd(p, d->f_pos_n);
+    double moved = 0;
+    for (size_t i = 0; i < p->n_owned; i++) {
+        double r2 = 0;
+        for (int c = 0; c < 3; c++)
+            r2 += (p->pos[3 * i + c] - xn[3 * i + c]) * (p->pos[3 * i + c] - xn[3 * i + c]);
+        moved = fmax(moved, sqrt(r2));
+    }
+    mf_parallel_max(sim->par, &moved, 1);
+    const double l0 = sim->l0, travel = moved + 0.2 * l0;
+    return 2.0 * fmax(d->s.grid_spacing * l0, travel) + d->s.re_interpolation * l0;
+}
+
 int mafl_step(mafl_data *d, mf_sim *sim, double dt)
 {
     mf_particles *p = sim->p;
@@ -78,22 +119,28 @@ int mafl_step(mafl_data *d, mf_sim *sim, double dt)
     double t1 = mf_wall_seconds();
     d->t_lagrangian += t1 - t0;
 
-    /* 2. Reconfiguration: r^{n+1}, u^c, u^a, with neighbours at r^L. */
-    memcpy(d->pos_l, p->pos, 3 * p->n * sizeof *d->pos_l);
+    /* 2. Reconfiguration: r^{n+1}, u^c, u^a, with neighbours at r^L
+     * (inlet points with their prescribed velocity, which the Eulerian
+     * phase reads of them). */
+    restore_inlet_velocity(d, p);
     double cell = d->s.re_interpolation;
     if (d->s.mps.re_gradient > cell)
         cell = d->s.mps.re_gradient;
     if (cell < 1.5)
         cell = 1.5;
+    if (d->halo)
+        MF_CALL(mafl_copies(d, sim, fmax(cell * sim->l0, eulerian_reach(d, sim)), true));
+    memcpy(d->pos_l, p->pos, 3 * p->n * sizeof *d->pos_l);
     MF_CALL(mf_neighbours_grid(sim->neighbours, p, cell * sim->l0, &d->grid));
     MF_CALL(mafl_reconfigure(d, sim, dt));
     double t2 = mf_wall_seconds();
     d->t_reconfigure += t2 - t1;
 
     /* 3. Eulerian phase: every carried field to r^{n+1}. */
-    restore_inlet_velocity(d, p);
     MF_CALL(mafl_eulerian(d, sim, dt));
     commit(d, sim);
+    if (d->halo)
+        mf_halo_drop(d->halo, p);
     double t3 = mf_wall_seconds();
     d->t_eulerian += t3 - t2;
 

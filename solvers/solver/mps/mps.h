@@ -101,6 +101,7 @@ typedef struct mps_data {
     double *grad;      /* 3n: pressure gradient */
     uint8_t *is_fluid, *in_ppe, *dirichlet, *not_dummy;
     long *row;         /* particle -> PPE row, -1 if not in the system */
+    long *row_global;  /* on several ranks: particle -> global PPE row (copies: their owners') */
     double *rhs, *x;
     mf_csr A;
     size_t cap_rows, cap_nnz;
@@ -154,10 +155,10 @@ typedef struct mps_data {
     void *before_assembly_ctx;
     /* Implicit viscosity (mps_viscosity.c); NULL with `viscosity explicit`. */
     struct mps_viscosity *visc;
-    /* Periodic images along x (mps_periodic.c); NULL without a period. While a
-     * step runs, particles [n_owned, n) are images of image_owner[k - n_owned]. */
-    struct mps_periodic *periodic;
-    const size_t *image_owner;
+    /* Copies of other ranks' particles and periodic images (mps_halo.c); NULL
+     * in a serial run without a period. While a step runs, particles
+     * [n_owned, n) are copies. */
+    struct mps_halo *halo;
 } mps_data;
 
 enum { MPS_FLAG_SURFACE = 1 }; /* bits of the Flags field */
@@ -335,22 +336,36 @@ void mps_viscosity_destroy(struct mps_viscosity *v);
 int mps_viscosity_implicit(mps_data *d, mf_sim *sim, double dt);
 void mps_viscosity_report(const struct mps_viscosity *v, const mf_sim *sim, mf_log *log);
 
-/* mps_periodic.c: a periodic x axis by image particles. Before each grid
- * build, fluid is wrapped into [x0, x0 + L) and particles within the largest
- * radius of a periodic face get an image shifted by -+L (appended after
- * n_owned); operators read the images like any neighbour and the PPE maps
- * an image to its owner's row. mps_periodic_end removes the images. */
-int mps_periodic_create(mps_data *d, mf_sim *sim, double rmax);
-void mps_periodic_destroy(struct mps_periodic *pp);
-int mps_periodic_begin(mps_data *d, mf_sim *sim); /* wrap, remove old images */
-int mps_periodic_add_images(mps_data *d, mf_sim *sim);
-void mps_periodic_end(mps_data *d, mf_sim *sim);  /* wrap, remove images */
-/* Copy per-particle values of owners to their images (n values of size bytes each). */
-void mps_periodic_sync(const mps_data *d, const mf_particles *p, void *values, size_t size);
-/* Owner of particle j (j itself when it is not an image). */
-static inline size_t mps_owner(const mps_data *d, const mf_particles *p, size_t j)
-{
-    return j < p->n_owned || !d->image_owner ? j : d->image_owner[j - p->n_owned];
-}
+/* mps_halo.c: copies of other ranks' particles (a -parallel run) and
+ * periodic images along x, appended after n_owned for the duration of a
+ * step; operators read them like any neighbour, mps_halo_sync gives them
+ * their owners' values of what a phase computed (masks, global PPE rows,
+ * pressure). Nothing of it exists in a serial run without a period. */
+int mps_halo_create(mps_data *d, mf_sim *sim);
+void mps_halo_destroy(struct mps_halo *mh);
+/* A particle field the copies carry, at r^n (the explicit phase) and/or at
+ * r* (the pressure phase). */
+enum { MPS_HALO_START = 1, MPS_HALO_STAR = 2 };
+int mps_halo_add_field(mps_data *d, int field, int when);
+/* Drop the copies, wrap the period; at the first build of a step
+ * (step_start) particles also migrate between ranks. */
+int mps_halo_begin(mps_data *d, mf_sim *sim, bool step_start);
+int mps_halo_add(mps_data *d, mf_sim *sim, bool at_star); /* build the copies */
+void mps_halo_end(mps_data *d, mf_sim *sim);    /* drop them, wrap */
+/* The copies of values (n values of size bytes each) from their owners.
+ * Collective; nothing without a halo. */
+int mps_halo_sync(const mps_data *d, const mf_sim *sim, void *values, size_t size);
+/* Positions and velocities of the copies from their owners'. */
+int mps_halo_sync_motion(const mps_data *d, const mf_sim *sim);
+/* Rows over the ranks: row[i] of the owned particles holds a local row (or
+ * -1) of the nrows this rank has. *offset, *nglobal: where this rank's rows
+ * start (the ranks' rows follow each other in rank order) and how many
+ * there are in all. On one rank an image's row[j] becomes its owner's and
+ * *global_col is NULL (column = offset + row). On several, global[] (n
+ * entries) holds every particle's global row, the copies their owners',
+ * row[j] of a copy says only whether it has one (0 or -1), and *global_col
+ * is global (mf_rows.global_col). */
+int mps_global_rows(const mps_data *d, const mf_sim *sim, long *row, size_t nrows,
+                    long *global, int64_t *offset, int64_t *nglobal, const long **global_col);
 
 #endif

@@ -114,7 +114,8 @@ int mps_reserve(mps_data *d, size_t n)
         mf_resize(&d->grad, 3 * cap, sizeof *d->grad) ||
         mf_resize(&d->is_fluid, cap, 1) || mf_resize(&d->in_ppe, cap, 1) ||
         mf_resize(&d->dirichlet, cap, 1) || mf_resize(&d->not_dummy, cap, 1) ||
-        mf_resize(&d->row, cap, sizeof *d->row))
+        mf_resize(&d->row, cap, sizeof *d->row) ||
+        mf_resize(&d->row_global, cap, sizeof *d->row_global))
         return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu particles", n);
     d->cap = cap;
     return 0;
@@ -157,6 +158,7 @@ int mps_create_data(const mps_settings *s, mf_sim *sim, const mf_dict *solver_di
                                    sizeof where));
     }
     MF_CALL(mps_reserve(d, sim->p->n));
+    MF_CALL(mps_halo_create(d, sim)); /* copies from other ranks (none in a serial run) */
     const mf_kernel *ks[3] = {&d->k_nd, &d->k_grad, &d->k_lap};
     const char *names[3] = {"number density", "gradient", "Laplacian"};
     for (int k = 0; k < 3; k++)
@@ -176,7 +178,7 @@ void mps_destroy_data(mps_data *d)
         d->pressure_ops->destroy(d->pressure.data);
     mf_module_release(&d->pressure);
     mps_viscosity_destroy(d->visc);
-    mps_periodic_destroy(d->periodic);
+    mps_halo_destroy(d->halo);
     free(d->acc);
     free(d->grad);
     free(d->is_fluid);
@@ -184,6 +186,7 @@ void mps_destroy_data(mps_data *d)
     free(d->dirichlet);
     free(d->not_dummy);
     free(d->row);
+    free(d->row_global);
     free(d->slot);
     free(d->rhs);
     free(d->x);
@@ -202,19 +205,18 @@ static int mps_create(const void *settings, mf_sim *sim, const mf_dict *solver_d
                         "use solver multiFluid",
                         sim->nfluids, sim->fluid[0].name, sim->fluid[1].name,
                         sim->nfluids > 2 ? ", ..." : "");
-    /* Only this solver has a periodic axis (mps_periodic.c): the composing
+    /* Only this solver has a periodic axis (mps_halo.c): the composing
      * solvers call the phases themselves. */
     mps_settings s = *(const mps_settings *)settings;
     const double period = s.periodic_length;
     s.periodic_length = 0;
     mps_data *d = NULL;
     int rc = mps_create_data(&s, sim, solver_dict, &d);
-    if (rc == 0 && period > 0) {
+    if (rc == 0 && period > 0) { /* the halo of mps_create_data gains the period */
+        mps_halo_destroy(d->halo);
+        d->halo = NULL;
         d->s.periodic_length = period;
-        double rmax = d->k_nd.re;
-        if (d->k_grad.re > rmax) rmax = d->k_grad.re;
-        if (d->k_lap.re > rmax) rmax = d->k_lap.re;
-        rc = mps_periodic_create(d, sim, rmax);
+        rc = mps_halo_create(d, sim);
     }
     if (rc != 0) {
         mps_destroy_data(d);
@@ -246,10 +248,29 @@ static void mps_report(void *data, const mf_sim *sim, mf_log *log)
                   1e3 * d->t_assembly / attempts, 1e3 * d->t_solve / attempts,
                   1e3 * d->t_setup / attempts, 1e3 * d->t_pcg / attempts,
                   1e3 * d->t_correction / attempts, 1e3 * total / attempts);
+    if (sim->par) { /* every rank's split: where the ranks wait for each other */
+        const int size = mf_parallel_size(sim->par);
+        double mine[5] = {d->t_neighbours, d->t_explicit, d->t_assembly, d->t_solve,
+                          d->t_correction};
+        double *all = malloc(5 * (size_t)size * sizeof *all);
+        if (all) {
+            mf_parallel_allgather(sim->par, mine, sizeof mine, all);
+            for (int r = 0; r < size && r < 16; r++)
+                mf_log_printf(log, MF_LOG_QUIET,
+                              "    rank %d (ms/step): neighbours and halo %.3f, explicit %.3f, "
+                              "assembly %.3f, solve %.3f, correction %.3f\n",
+                              r, 1e3 * all[5 * r] / attempts, 1e3 * all[5 * r + 1] / attempts,
+                              1e3 * all[5 * r + 2] / attempts, 1e3 * all[5 * r + 3] / attempts,
+                              1e3 * all[5 * r + 4] / attempts);
+            free(all);
+        }
+    }
+    double rows = (double)d->ppe_rows; /* over the ranks */
+    mf_parallel_sum(sim->par, &rows, 1);
     mf_log_printf(log, MF_LOG_QUIET,
-                  "MPS pressure: %ld unknowns in the last solve, %.2f iterations per solve on "
+                  "MPS pressure: %.0f unknowns in the last solve, %.2f iterations per solve on "
                   "average\n",
-                  d->ppe_rows,
+                  rows,
                   (double)sim->pressure_iterations / (d->solves > 0 ? (double)d->solves : 1.0));
     mf_neighbours_stats nb;
     mf_neighbours_get_stats(d->nb, &nb);

@@ -59,8 +59,7 @@ int mps_gradient_pairs(mps_data *d, const mf_sim *sim, const double *pressure,
         MF_CALL(mps_scheme_reserve(d, sim->p->n));
         double *fhat = d->work;
         mf_neighbour_min(&v, pressure, true, d->own_reference, d->not_dummy, d->not_dummy, fhat);
-        if (d->periodic)
-            mps_periodic_sync(d, sim->p, fhat, sizeof *fhat);
+        MF_CALL(mps_halo_sync(d, sim, fhat, sizeof *fhat)); /* copies: their owners' p^ */
         o.fhat = fhat;
     }
     mf_gradient_ex(&v, &d->k_grad, &o, im, d->not_dummy, d->grad);

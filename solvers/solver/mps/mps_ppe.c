@@ -50,33 +50,92 @@ static int reserve_system(mps_data *d, size_t rows, size_t nnz)
     return 0;
 }
 
-/* Rows reachable from a row that touches a Dirichlet particle are fine;
- * the rest form closed groups. Breadth-first over the matrix graph. */
-static size_t regularise_closed_groups(mps_data *d, const uint8_t *touches_dirichlet)
+/* Is j a copy of another rank's unknown that its owner's search reached? */
+typedef struct reach_ctx {
+    const uint8_t *in_ppe, *flag;
+    size_t n_owned;
+} reach_ctx;
+
+static inline bool reached_copy(void *acc, const void *ctx, const mf_pair *pr)
 {
+    const reach_ctx *c = ctx;
+    if (pr->j >= c->n_owned && c->in_ppe[pr->j] && c->flag[pr->j]) {
+        *(bool *)acc = true;
+        return false;
+    }
+    return true;
+}
+
+/* Rows reachable from a row that touches a Dirichlet particle are fine;
+ * the rest form closed groups. Breadth-first over the matrix graph; on
+ * several ranks in rounds: each rank searches its rows, the copies learn
+ * whether their owners were reached, and a row next to a reached copy
+ * starts the next round, until no rank reaches a new row. */
+static int regularise_closed_groups(mps_data *d, const mf_sim *sim, const mf_pairs *nl,
+                                    const uint8_t *touches_dirichlet, size_t *nfixed)
+{
+    const mf_particles *p = sim->p;
     const size_t nrows = d->A.nrows;
+    const int64_t offset = d->A.row_offset;
+    const bool across = sim->par != NULL;
     uint8_t *seen = calloc(nrows ? nrows : 1, 1);
     size_t *queue = malloc((nrows ? nrows : 1) * sizeof *queue);
-    if (!seen || !queue) {
-        free(seen);
-        free(queue);
-        return 0;
-    }
+    uint8_t *flag = across ? calloc(p->n ? p->n : 1, 1) : NULL;
+    int rc = !seen || !queue || (across && !flag)
+                 ? MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu pressure rows", nrows)
+                 : 0;
+    if (rc != 0 && !across)
+        goto done;
     size_t head = 0, tail = 0;
-    for (size_t r = 0; r < nrows; r++)
+    for (size_t r = 0; rc == 0 && r < nrows; r++)
         if (touches_dirichlet[r]) {
             seen[r] = 1;
             queue[tail++] = r;
         }
-    while (head < tail) {
-        size_t r = queue[head++];
-        for (size_t k = d->A.rowptr[r]; k < d->A.rowptr[r + 1]; k++) {
-            size_t c = (size_t)(d->A.col[k] - d->A.row_offset);
-            if (c < nrows && !seen[c]) {
-                seen[c] = 1;
-                queue[tail++] = c;
+    for (int round = 0;; round++) {
+        while (head < tail) {
+            size_t r = queue[head++];
+            for (size_t k = d->A.rowptr[r]; k < d->A.rowptr[r + 1]; k++) {
+                size_t c = (size_t)(d->A.col[k] - offset);
+                if (c < nrows && !seen[c]) {
+                    seen[c] = 1;
+                    queue[tail++] = c;
+                }
             }
         }
+        if (!across)
+            break;
+        if (round == 0) { /* the usual case: every row reached on every rank */
+            double open[2] = {(double)(nrows - tail), rc != 0};
+            if (rc != 0)
+                open[0] = 0;
+            mf_parallel_sum(sim->par, open, 2);
+            if (open[1] > 0) {
+                rc = mf_parallel_agree(sim->par, rc);
+                goto done;
+            }
+            if (open[0] == 0)
+                break;
+        }
+        for (size_t i = 0; i < p->n_owned; i++)
+            flag[i] = d->row[i] >= 0 && seen[d->row[i]];
+        MF_CALL_GOTO(rc, mps_halo_sync(d, sim, flag, 1), done);
+        double reached = 0;
+        for (size_t i = 0; i < p->n_owned; i++) {
+            if (d->row[i] < 0 || seen[d->row[i]])
+                continue;
+            const reach_ctx rc_ctx = {d->in_ppe, flag, p->n_owned};
+            bool hit = false;
+            mf_pairs_row_r2(nl, i, NULL, reached_copy, &rc_ctx, &hit);
+            if (hit) {
+                seen[d->row[i]] = 1;
+                queue[tail++] = (size_t)d->row[i];
+                reached++;
+            }
+        }
+        mf_parallel_sum(sim->par, &reached, 1);
+        if (reached == 0)
+            break;
     }
     size_t fixed = 0;
     for (size_t r = 0; r < nrows; r++)
@@ -85,9 +144,12 @@ static size_t regularise_closed_groups(mps_data *d, const uint8_t *touches_diric
             d->A.val[d->A.rowptr[r]] *= 2.0;
             fixed++;
         }
+    *nfixed = fixed;
+done:
     free(seen);
     free(queue);
-    return fixed;
+    free(flag);
+    return rc;
 }
 
 /* One PPE row (the header's A_ii, A_ij, rhs_i) from the pair engine's
@@ -195,28 +257,35 @@ int mps_assemble_ppe(mps_data *d, const mf_sim *sim, double dt)
 {
     double t0 = mf_wall_seconds();
     const mf_particles *p = sim->p;
+    /* Which copies are unknowns: their owners decided (a composing solver
+     * may have changed the owned ones since the surface phase). */
+    MF_CALL(mps_halo_sync(d, sim, d->in_ppe, 1));
     size_t nrows = 0;
     for (size_t i = 0; i < p->n_owned; i++)
         d->row[i] = d->in_ppe[i] ? (long)nrows++ : -1;
-    if (d->periodic) /* an image is its owner's unknown */
-        mps_periodic_sync(d, p, d->row, sizeof *d->row);
-    if (p->global_offset + (int64_t)nrows > MF_CSR_MAX_GLOBAL)
+    /* Rows over the ranks: a copy is its owner's unknown (an image, or a
+     * particle of another rank). */
+    int64_t offset = 0, nglobal = 0;
+    const long *global_col = NULL;
+    MF_CALL(mps_global_rows(d, sim, d->row, nrows, d->row_global, &offset, &nglobal,
+                            &global_col));
+    if (nglobal > MF_CSR_MAX_GLOBAL)
         return MF_ERROR(MF_ERR_INPUT,
-                        "%zu pressure unknowns: the matrix's columns are 32-bit (hypre's "
+                        "%lld pressure unknowns: the matrix's columns are 32-bit (hypre's "
                         "HYPRE_BigInt), at most %d in all",
-                        nrows, MF_CSR_MAX_GLOBAL);
+                        (long long)nglobal, MF_CSR_MAX_GLOBAL);
     MF_CALL(reserve_system(d, nrows, 0));
     uint8_t *touches = calloc(nrows ? nrows : 1, 1);
     if (!touches)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory");
     mf_csr *A = &d->A;
     A->nrows = nrows;
-    A->row_offset = p->global_offset;
-    A->nglobal = (int64_t)nrows; /* one rank */
+    A->row_offset = offset;
+    A->nglobal = nglobal;
     ppe_ctx c = {
         .d = d,
         .sim = sim,
-        .rows = {d->row, A->row_offset, A->rowptr, A->col, A->val},
+        .rows = {d->row, A->row_offset, A->rowptr, A->col, A->val, global_col},
         .c = 2.0 * d->k_lap.dim / (d->k_lap.lambda * d->k_lap.n0),
         .dt = dt,
         .rho = sim->fluid[0].rho,
@@ -259,12 +328,19 @@ int mps_assemble_ppe(mps_data *d, const mf_sim *sim, double dt)
                       sim->time, sim->step, (long long)p->id[i], p->pos[3 * i],
                       p->pos[3 * i + 1], p->pos[3 * i + 2]);
     }
+    /* Every rank learns of a particle inside a wall before the solve. */
+    rc = mf_parallel_agree(sim->par, rc);
     if (rc != 0) {
         free(touches);
         return mf_error_trace(rc, __FILE__, __LINE__, __func__);
     }
-    size_t closed = regularise_closed_groups(d, touches);
+    size_t closed = 0;
+    rc = regularise_closed_groups(d, sim, &c.v, touches, &closed);
     free(touches);
+    MF_CALL(rc);
+    double nclosed = (double)closed; /* over the ranks */
+    mf_parallel_sum(sim->par, &nclosed, 1);
+    closed = (size_t)nclosed;
     if (closed)
         mf_log_printf(sim->log, MF_LOG_VERBOSE,
                       "PPE: %zu unknowns have no free surface to refer to: diagonal doubled\n",
@@ -274,47 +350,121 @@ int mps_assemble_ppe(mps_data *d, const mf_sim *sim, double dt)
     return 0;
 }
 
-/* The pressure solve did not converge (MF_RETRY from the pressure module):
- * name it as the run's watch names its criteria (pressureSolve), with the
- * time, the residuals and the particle of the largest residual, so that a
- * run stopped by it says where. Stays MF_RETRY: a smaller step may fix it. */
-static int solve_failed(const mps_data *d, const mf_sim *sim)
+/* x of another rank's row, from the copies' (global row, value) pairs. */
+typedef struct row_value {
+    int64_t row;
+    double x;
+} row_value;
+
+static int by_row(const void *a, const void *b)
+{
+    int64_t x = ((const row_value *)a)->row, y = ((const row_value *)b)->row;
+    return (x > y) - (x < y);
+}
+
+static double remote_x(const row_value *t, size_t n, int64_t row)
+{
+    size_t lo = 0, hi = n;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (t[mid].row < row)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo < n && t[lo].row == row ? t[lo].x : NAN;
+}
+
+/* The largest residual |b - A x| of this rank's rows and its particle
+ * (SIZE_MAX when there is none). Other ranks' x come through the copies. */
+static int worst_row(mps_data *d, const mf_sim *sim, double *rmax, size_t *particle)
 {
     const mf_particles *p = sim->p;
     const mf_csr *A = &d->A;
-    size_t worst = 0;
-    double rmax = -1;
-    for (size_t r = 0; r < A->nrows; r++) {
+    const int64_t offset = A->row_offset;
+    double *xp = d->grad; /* scratch, n values: the step is lost anyway */
+    for (size_t i = 0; i < p->n_owned; i++)
+        xp[i] = d->row[i] >= 0 ? d->x[d->row[i]] : 0.0;
+    MF_CALL(mps_halo_sync(d, sim, xp, sizeof *xp));
+    /* A copy's global row (on one rank an image's row is its owner's). */
+    const long *grow = sim->par ? d->row_global : d->row;
+    size_t nt = 0;
+    row_value *t = malloc((p->n - p->n_owned + 1) * sizeof *t);
+    int rc = mf_parallel_agree(sim->par, t ? 0 : MF_ERROR(MF_ERR_MEMORY, "out of memory"));
+    if (rc != 0) {
+        free(t);
+        return rc;
+    }
+    for (size_t j = p->n_owned; j < p->n; j++)
+        if (grow[j] >= 0 && (grow[j] < offset || grow[j] >= offset + (int64_t)A->nrows))
+            t[nt++] = (row_value){grow[j], xp[j]};
+    qsort(t, nt, sizeof *t, by_row);
+    *rmax = -1;
+    *particle = SIZE_MAX;
+    for (size_t i = 0; i < p->n_owned; i++) {
+        if (d->row[i] < 0)
+            continue;
+        const size_t r = (size_t)d->row[i];
         double res = d->rhs[r];
-        for (size_t k = A->rowptr[r]; k < A->rowptr[r + 1]; k++)
-            res -= A->val[k] * d->x[A->col[k] - A->row_offset];
-        if (!(fabs(res) <= rmax)) {
-            rmax = fabs(res);
-            worst = r;
+        for (size_t k = A->rowptr[r]; k < A->rowptr[r + 1]; k++) {
+            const int64_t c = A->col[k];
+            const double xc = c >= offset && c < offset + (int64_t)A->nrows
+                                  ? d->x[c - offset]
+                                  : remote_x(t, nt, c);
+            res -= A->val[k] * xc;
+        }
+        if (!(fabs(res) <= *rmax)) {
+            *rmax = isfinite(res) ? fabs(res) : INFINITY;
+            *particle = i;
         }
     }
-    size_t i = 0;
-    while (i < p->n_owned && d->row[i] != (long)worst)
-        i++;
+    free(t);
+    return 0;
+}
+
+/* The pressure solve did not converge (MF_RETRY from the pressure module,
+ * on every rank): name it as the run's watch names its criteria
+ * (pressureSolve), with the time, the residuals and the particle of the
+ * largest residual over all ranks, so that a run stopped by it says where.
+ * Stays MF_RETRY: a smaller step may fix it. */
+static int solve_failed(mps_data *d, const mf_sim *sim)
+{
+    const mf_particles *p = sim->p;
+    double rmax = -1;
+    size_t i = SIZE_MAX;
+    MF_CALL(worst_row(d, sim, &rmax, &i));
+    int who = 0;
+    mf_parallel_maxloc(sim->par, &rmax, &who);
+    struct {
+        int found, kind;
+        long long id;
+        double x[3];
+    } w = {0, 0, 0, {0, 0, 0}};
+    if (mf_parallel_rank(sim->par) == who && i != SIZE_MAX) {
+        w.found = 1;
+        w.kind = p->kind[i];
+        w.id = (long long)p->id[i];
+        memcpy(w.x, &p->pos[3 * i], sizeof w.x);
+    }
+    mf_parallel_bcast(sim->par, &w, sizeof w, who);
     const char *why = d->last.final_residual > d->last.initial_residual ||
                               !isfinite(d->last.final_residual)
                           ? ", diverging"
                           : "";
-    if (i == p->n_owned)
+    if (!w.found)
         return MF_ERROR(MF_RETRY,
                         "unstable (pressureSolve) at time %g, step %ld: %s not converged after "
                         "%d iterations (relative residual %g, from %g%s)",
                         sim->time + sim->dt, sim->step + 1, d->pressure.info->name,
                         d->last.iterations, d->last.final_residual, d->last.initial_residual,
                         why);
-    const double *x = &p->pos[3 * i];
     return MF_ERROR(MF_RETRY,
                     "unstable (pressureSolve) at time %g, step %ld: %s not converged after %d "
                     "iterations (relative residual %g, from %g%s); largest residual at %s "
                     "particle id %lld at (%g %g %g)",
                     sim->time + sim->dt, sim->step + 1, d->pressure.info->name,
                     d->last.iterations, d->last.final_residual, d->last.initial_residual, why,
-                    mf_particle_kind_name(p->kind[i]), (long long)p->id[i], x[0], x[1], x[2]);
+                    mf_particle_kind_name(w.kind), w.id, w.x[0], w.x[1], w.x[2]);
 }
 
 /* The rows' names for the pressure module (mf_row_names): slot = the particle's
@@ -365,7 +515,7 @@ int mps_solve_ppe(mps_data *d, mf_sim *sim)
     d->t_pcg += d->last.solve_seconds;
     d->t_solve += mf_wall_seconds() - t0;
     if (rc == MF_RETRY)
-        return solve_failed(d, sim);
+        return solve_failed(d, sim); /* every rank gets MF_RETRY: the solve is collective */
     if (rc != 0)
         return mf_error_trace(rc, __FILE__, __LINE__, __func__);
     double *pressure = mf_particles_fd(p, d->f_pressure);
@@ -373,7 +523,6 @@ int mps_solve_ppe(mps_data *d, mf_sim *sim)
         double v = d->row[i] >= 0 ? d->x[d->row[i]] : (d->p_dirichlet ? d->p_dirichlet[i] : 0.0);
         pressure[i] = (d->s.clip_negative_pressure && v < 0) ? 0.0 : v;
     }
-    if (d->periodic)
-        mps_periodic_sync(d, p, pressure, sizeof *pressure);
+    MF_CALL(mps_halo_sync(d, sim, pressure, sizeof *pressure));
     return 0;
 }

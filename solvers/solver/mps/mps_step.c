@@ -19,8 +19,8 @@ int mps_build_neighbours(mps_data *d, mf_sim *sim, bool reorder)
 {
     double t0 = mf_wall_seconds();
     mf_particles *p = sim->p;
-    if (d->periodic)
-        MF_CALL(mps_periodic_begin(d, sim)); /* wrap, drop the last images */
+    if (d->halo) /* drop the last copies, wrap; migrate at the start of a step */
+        MF_CALL(mps_halo_begin(d, sim, reorder));
     if (reorder && d->s.reorder_interval > 0 && sim->step % d->s.reorder_interval == 0) {
         /* Sort along cells: neighbours become neighbours in memory too. */
         size_t *perm = malloc((p->n ? p->n : 1) * sizeof *perm);
@@ -32,8 +32,8 @@ int mps_build_neighbours(mps_data *d, mf_sim *sim, bool reorder)
         free(perm);
         MF_CALL(rc);
     }
-    if (d->periodic) /* images across the periodic faces */
-        MF_CALL(mps_periodic_add_images(d, sim));
+    if (d->halo) /* copies from other ranks and across the period */
+        MF_CALL(mps_halo_add(d, sim, !reorder)); /* reorder: the build at r^n */
     MF_CALL(mf_neighbours_update(d->nb, p, d->h_max));
     d->t_neighbours += mf_wall_seconds() - t0;
     return 0;
@@ -161,8 +161,8 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
             p->pos[3 * i + c] += dt * p->vel[3 * i + c];
         }
     }
-    if (d->periodic) /* images move with their owners */
-        mps_periodic_sync(d, p, p->vel, 3 * sizeof(double));
+    if (d->halo) /* copies move with their owners (the collision model reads them) */
+        MF_CALL(mps_halo_sync_motion(d, sim));
     if (d->s.collision)
         MF_CALL(collide(d, sim, dt));
     d->t_explicit += mf_wall_seconds() - t0;
@@ -233,10 +233,8 @@ int mps_surface_phase(mps_data *d, mf_sim *sim)
         if (!d->not_dummy[i])
             n[i] = 0; /* dummies take part only as neighbours */
     }
-    if (d->periodic) { /* an image is what its owner is */
-        mps_periodic_sync(d, p, d->dirichlet, 1);
-        mps_periodic_sync(d, p, d->in_ppe, 1);
-    }
+    if (d->halo) /* a copy is what its owner is (its unknowns: mps_assemble_ppe) */
+        MF_CALL(mps_halo_sync(d, sim, d->dirichlet, 1));
     d->t_assembly += mf_wall_seconds() - t0;
     return 0;
 }
@@ -289,8 +287,11 @@ int mps_correction_phase(mps_data *d, mf_sim *sim, double dt)
             p->pos[3 * i + c] += dt * du;
         }
     }
-    if (d->s.collision && d->s.collision_after_correction)
+    if (d->s.collision && d->s.collision_after_correction) {
+        if (d->halo) /* the corrected motion of the copies' owners */
+            MF_CALL(mps_halo_sync_motion(d, sim));
         MF_CALL(collide(d, sim, dt));
+    }
     d->t_correction += mf_wall_seconds() - t0;
     MF_CALL(mps_shift(d, sim));
     return 0;
@@ -305,7 +306,7 @@ int mps_lagrangian_step(mps_data *d, mf_sim *sim, double dt)
     MF_CALL(mps_build_neighbours(d, sim, false)); /* at r*, for the pressure */
     MF_CALL(mps_pressure_phase(d, sim, dt));
     MF_CALL(mps_correction_phase(d, sim, dt));
-    if (d->periodic)
-        mps_periodic_end(d, sim); /* wrap, remove the images */
+    if (d->halo)
+        mps_halo_end(d, sim); /* drop the copies, wrap */
     return 0;
 }

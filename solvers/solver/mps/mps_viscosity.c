@@ -18,7 +18,8 @@
  * With a viscosity per particle (mps_data.mu, multi-fluid, eq. 27) row i is
  * multiplied by rho_i: A_ii = rho_i + dt c sum_j mu_ij w_ij, A_ij = -dt c
  * mu_ij w_ij, which keeps it symmetric since mu_ij is a symmetric average.
- * Periodic images (mps_periodic.c) map to their owner's row.
+ * Copies (periodic images, other ranks' particles: mps_halo.c) map to their
+ * owner's row.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -35,6 +36,7 @@ typedef struct mps_viscosity {
     mf_csr A;
     double *b, *x;
     long *row; /* particle -> row, -1: not an unknown */
+    long *row_global; /* on several ranks: particle -> global row (copies: their owners') */
     size_t cap_p, cap_rows, cap_nnz;
     long solves, iterations;
     double seconds;
@@ -74,6 +76,7 @@ void mps_viscosity_destroy(mps_viscosity *v)
     free(v->b);
     free(v->x);
     free(v->row);
+    free(v->row_global);
     free(v);
 }
 
@@ -81,7 +84,8 @@ static int reserve(mps_viscosity *v, size_t np, size_t rows, size_t nnz)
 {
     if (np > v->cap_p) {
         size_t cap = np + np / 4 + 64;
-        if (mf_resize(&v->row, cap, sizeof *v->row))
+        if (mf_resize(&v->row, cap, sizeof *v->row) ||
+            mf_resize(&v->row_global, cap, sizeof *v->row_global))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu particles", np);
         v->cap_p = cap;
     }
@@ -171,13 +175,14 @@ static int visc_sized(void *ctx, size_t nnz)
 
 /* Matrix of the fluid rows and, in dirichlet (3 per row), the wall
  * contributions dt c mu_ij w_ij u_j. */
-static int assemble(mps_data *d, const mf_sim *sim, double dt, double *dirichlet)
+static int assemble(mps_data *d, const mf_sim *sim, double dt, double *dirichlet,
+                    const long *global_col)
 {
     mps_viscosity *v = d->visc;
     mf_csr *A = &v->A;
     visc_ctx c = {
         .d = d,
-        .rows = {v->row, A->row_offset, A->rowptr, A->col, A->val},
+        .rows = {v->row, A->row_offset, A->rowptr, A->col, A->val, global_col},
         .vel = sim->p->vel,
         .nu = sim->fluid[0].nu,
         .dtc = dt * 2.0 * d->k_lap.dim / (d->k_lap.lambda * d->k_lap.n0),
@@ -199,21 +204,25 @@ int mps_viscosity_implicit(mps_data *d, mf_sim *sim, double dt)
     MF_CALL(reserve(v, p->n, 0, 0));
     for (size_t i = 0; i < p->n_owned; i++)
         v->row[i] = d->is_fluid[i] ? (long)rows++ : -1;
-    for (size_t j = p->n_owned; j < p->n; j++) /* periodic images: their owner's row */
-        v->row[j] = v->row[mps_owner(d, p, j)];
-    if (p->global_offset + (int64_t)rows > MF_CSR_MAX_GLOBAL)
+    /* Rows over the ranks; copies (images, other ranks' particles) are their
+     * owners' unknowns. */
+    int64_t offset = 0, nglobal = 0;
+    const long *global_col = NULL;
+    MF_CALL(mps_global_rows(d, sim, v->row, rows, v->row_global, &offset, &nglobal,
+                            &global_col));
+    if (nglobal > MF_CSR_MAX_GLOBAL)
         return MF_ERROR(MF_ERR_INPUT,
-                        "%zu viscous unknowns: the matrix's columns are 32-bit (hypre's "
+                        "%lld viscous unknowns: the matrix's columns are 32-bit (hypre's "
                         "HYPRE_BigInt), at most %d in all",
-                        rows, MF_CSR_MAX_GLOBAL);
+                        (long long)nglobal, MF_CSR_MAX_GLOBAL);
     MF_CALL(reserve(v, p->n, rows, 0)); /* the entries: counted by assemble */
     v->A.nrows = rows;
-    v->A.row_offset = p->global_offset;
-    v->A.nglobal = (int64_t)rows; /* one rank */
+    v->A.row_offset = offset;
+    v->A.nglobal = nglobal;
     double *dirichlet = malloc(3 * (rows ? rows : 1) * sizeof *dirichlet);
     if (!dirichlet)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu viscous unknowns", rows);
-    int rc = assemble(d, sim, dt, dirichlet);
+    int rc = assemble(d, sim, dt, dirichlet, global_col);
     static const char *const names[3] = {"Ux", "Uy", "Uz"};
     const double t0 = mf_wall_seconds();
     for (int c = 0; rc == 0 && c < sim->dim; c++) {
@@ -243,10 +252,7 @@ int mps_viscosity_implicit(mps_data *d, mf_sim *sim, double dt)
                 p->vel[3 * i + c] += dt * d->acc[3 * i + c];
     if (rc != 0)
         return mf_error_trace(rc, __FILE__, __LINE__, __func__);
-    /* The velocity of images follows their owners (the collision model reads it). */
-    if (d->image_owner)
-        for (size_t j = p->n_owned; j < p->n; j++)
-            memcpy(&p->vel[3 * j], &p->vel[3 * mps_owner(d, p, j)], 3 * sizeof(double));
+    /* The copies' velocities follow after the explicit phase (mps_step.c). */
     for (size_t i = 0; i < p->n_owned; i++)
         if (d->is_fluid[i])
             for (int c = 0; c < 3; c++)

@@ -139,6 +139,8 @@ static int create_data(const multifluid_settings *s, mf_sim *sim, const mf_dict 
     d->surface_pressure = !d->iterative && mf_forces_claim_surface_pressure(sim);
     log_surface_pressure(d, sim);
     MF_CALL(multifluid_reserve(d, sim->p->n));
+    if (d->f_fluid >= 0) /* copies of other ranks' particles carry their fluid */
+        MF_CALL(mps_halo_add_field(d->mps, d->f_fluid, MPS_HALO_START | MPS_HALO_STAR));
     return 0;
 }
 

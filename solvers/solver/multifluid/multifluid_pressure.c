@@ -118,11 +118,12 @@ static int light_solve(multifluid_data *d, mf_sim *sim, double dt, long k, doubl
             m->in_ppe[i] = d->in_all[i] && !d->heavy_rows[i];
         m->rho = d->rho;
         memcpy(d->p_dirichlet, P, n * sizeof *P); /* the heavy solve's pressure */
+        MF_CALL(mps_halo_sync(m, sim, d->p_dirichlet, sizeof *d->p_dirichlet));
         m->p_dirichlet = d->p_dirichlet;
         memcpy(P, pl, n * sizeof *P);
     }
     MF_CALL(run_solve(m, sim, dt));
-    memcpy(pl, P, n * sizeof *P);
+    memcpy(pl, P, sim->p->n * sizeof *P); /* copies too: the solve synchronised P */
     return 0;
 }
 
@@ -139,6 +140,9 @@ static int rounds(multifluid_data *d, mf_sim *sim, double dt, long *made, double
     memcpy(d->in_all, m->in_ppe, n);
     size_t rows = 0;
     MF_CALL(set_heavy_unknowns(d, sim, &rows)); /* fills m->in_ppe */
+    double global_rows = (double)rows;
+    mf_parallel_sum(sim->par, &global_rows, 1); /* every rank solves, or none */
+    rows = (size_t)global_rows;
     memcpy(d->heavy_rows, m->in_ppe, n);
     memcpy(d->p_prev, P, n * sizeof *P);
     *made = 0;
@@ -163,7 +167,7 @@ static int rounds(multifluid_data *d, mf_sim *sim, double dt, long *made, double
         if (rows > 0)
             MF_CALL(run_solve(m, sim, dt));
         else
-            memcpy(P, pl, n * sizeof *P);
+            memcpy(P, pl, p->n * sizeof *P); /* copies too: pl's are its owners' */
         memcpy(d->p_prev, P, n * sizeof *P);
         /* 3. the correction each fluid's pressure makes (eq. 15), not applied
          * yet: the round has converged when it moves no particle by more
@@ -186,6 +190,7 @@ static int rounds(multifluid_data *d, mf_sim *sim, double dt, long *made, double
             if (c2 > change * change)
                 change = sqrt(c2);
         }
+        mf_parallel_max(sim->par, &change, 1); /* one decision for every rank */
         m->t_correction += mf_wall_seconds() - tc;
         double du = change * dt, dr = du * dt / sim->l0;
         *made = k;
@@ -213,6 +218,9 @@ int multifluid_iterative_pressure(multifluid_data *d, mf_sim *sim, double dt)
         d->heavy_mask[i] = fluid && d->heavy[fid[i]];
         d->light_mask[i] = fluid && !d->heavy[fid[i]];
     }
+    /* A wall is in the heavy solve when a heavy particle, maybe another
+     * rank's, is near: the copies' masks. */
+    MF_CALL(mps_halo_sync(m, sim, d->heavy_mask, sizeof *d->heavy_mask));
     long made = 0;
     double dr = 0;
     int rc = rounds(d, sim, dt, &made, &dr);

@@ -61,14 +61,26 @@ int multifluid_fill_properties(multifluid_data *d, const mf_sim *sim)
     return 0;
 }
 
+/* The copies' densities and viscosities are their owners' (a wall copy's
+ * neighbourhood is cut at the halo's edge, and the copies at r* are not
+ * those at r^n): the owned values persist through the step. */
+static int sync_properties(multifluid_data *d, const mf_sim *sim)
+{
+    const mps_data *m = d->mps;
+    MF_CALL(mps_halo_sync(m, sim, d->rho, sizeof *d->rho));
+    MF_CALL(mps_halo_sync(m, sim, d->mu, sizeof *d->mu));
+    MF_CALL(mps_halo_sync(m, sim, d->rho_light, sizeof *d->rho_light));
+    return 0;
+}
+
 /* One fluid with the Laplace pressure on its free surface: the phases of
  * mps_lagrangian_step, pressure and correction from multifluid_surface.c. */
 static int one_fluid_step(multifluid_data *d, mf_sim *sim, double dt)
 {
     mps_data *m = d->mps;
     MF_CALL(mps_reserve(m, sim->p->n));
-    MF_CALL(multifluid_reserve(d, sim->p->n));
     MF_CALL(mps_build_neighbours(m, sim, true));
+    MF_CALL(multifluid_reserve(d, sim->p->n)); /* particles may have come from other ranks */
     mps_set_masks(m, sim->p);
     MF_CALL(mps_explicit_phase(m, sim, dt));
     MF_CALL(mps_build_neighbours(m, sim, false));
@@ -78,7 +90,20 @@ static int one_fluid_step(multifluid_data *d, mf_sim *sim, double dt)
     return 0;
 }
 
+static int step_phases(multifluid_data *d, mf_sim *sim, double dt);
+
+/* The phases, then the copies of other ranks' particles (and images)
+ * dropped, as mps_lagrangian_step does: emitters and the writer see owned
+ * particles only. */
 int multifluid_step(multifluid_data *d, mf_sim *sim, double dt)
+{
+    int rc = step_phases(d, sim, dt);
+    if (d->mps->halo)
+        mps_halo_end(d->mps, sim);
+    return rc;
+}
+
+static int step_phases(multifluid_data *d, mf_sim *sim, double dt)
 {
     mps_data *m = d->mps;
     if (d->f_fluid < 0) { /* one fluid: the MPS step itself */
@@ -90,15 +115,17 @@ int multifluid_step(multifluid_data *d, mf_sim *sim, double dt)
     }
     mf_particles *p = sim->p;
     MF_CALL(mps_reserve(m, p->n));
+    MF_CALL(mps_build_neighbours(m, sim, true)); /* at r^n; may reorder or migrate particles */
     MF_CALL(multifluid_reserve(d, p->n));
-    MF_CALL(mps_build_neighbours(m, sim, true)); /* at r^n; may reorder the particles */
     mps_set_masks(m, p);
     MF_CALL(multifluid_fill_properties(d, sim));
+    MF_CALL(sync_properties(d, sim));
     m->rho = d->rho;
     m->mu = d->mu;
     m->p_dirichlet = NULL;
     MF_CALL(mps_explicit_phase(m, sim, dt));      /* eq. 27 */
     MF_CALL(mps_build_neighbours(m, sim, false)); /* at r* */
+    MF_CALL(sync_properties(d, sim)); /* the copies at r* are other particles */
     if (d->iterative) {
         MF_CALL(multifluid_iterative_pressure(d, sim, dt));
         MF_CALL(mps_shift(m, sim));

@@ -30,6 +30,7 @@ int multifluid_surface_pressure_phase(multifluid_data *d, mf_sim *sim, double dt
     mps_data *m = d->mps;
     MF_CALL(mps_surface_phase(m, sim));
     MF_CALL(mf_forces_surface_pressure(sim, m->dirichlet, d->p_dirichlet));
+    MF_CALL(mps_halo_sync(m, sim, d->p_dirichlet, sizeof *d->p_dirichlet)); /* the PPE reads it */
     m->p_dirichlet = d->p_dirichlet;
     int rc = mps_assemble_ppe(m, sim, dt);
     if (rc == 0)
