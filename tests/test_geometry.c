@@ -38,6 +38,7 @@
 #include "mf_error.h"
 #include "mf_mesh_import.h"
 #include "mf_scene.h"
+#include "mf_walls.h"
 #include "mf_test.h"
 #include "mf_trimesh.h"
 
@@ -221,7 +222,7 @@ static int scene_build(scene *s, const char *geometry_text)
 static void scene_free(scene *s)
 {
     mf_particles_destroy(s->sim.p);
-    free(s->sim.wall_boxes);
+    mf_walls_destroy(s->sim.walls);
     mf_dict_free(s->geometry);
     mf_dict_free(s->fluids);
     if (s->log_file)
@@ -889,7 +890,7 @@ static void test_warnings_and_errors(void)
         {"walls { w { type mesh; file \"empty.stl\"; } }", "empty"},
         {"walls { w { type mesh; file \"open.obj\"; side insde; } }", "did you mean 'inside'"},
         {"walls { w { type mesh; fiel \"open.obj\"; } }", "did you mean 'file'"},
-        {"obstacles { o { type box; min (0 0 0); max (1 1 1); } }", "type mesh"},
+        {"obstacles { o { type cylinder; centre (0.5 0.5 0.5); } }", "needs a centre and a radius"},
         {"fluidBlocks { f { type mesh; file \"open.obj\"; fluid watr; } }", "did you mean"},
     };
     for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {

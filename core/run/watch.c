@@ -9,6 +9,7 @@
 #include "mf_error.h"
 #include "mf_modules.h"
 #include "mf_scene.h"
+#include "mf_walls.h"
 
 const mf_param mf_watch_params[] = {
     {"enabled", MF_PARAM_BOOL, "yes", MF_NO_RANGE, NULL, offsetof(mf_watch_settings, enabled),
@@ -59,8 +60,9 @@ static int check_non_finite(const mf_sim *sim)
 }
 
 /* A fluid centre past the wall-particle line (l0/2 outside the enclosed
- * region) of a closed face, within that face's extent, went through it
- * (mf_scene_past_wall: the dry run refuses a scene that starts so). */
+ * region) of a closed face, within that face's extent, or inside an
+ * obstacle by more than l0/2, went through it (mf_scene_past_wall: the dry
+ * run refuses a scene that starts so). */
 static int check_walls(const mf_sim *sim)
 {
     const mf_particles *p = sim->p;
@@ -71,13 +73,18 @@ static int check_walls(const mf_sim *sim)
         if (p->kind[i] != MF_FLUID || !mf_scene_past_wall(sim, i, &b, &a, &side))
             continue;
         const double *x = &p->pos[3 * i];
+        const mf_wall *w = &sim->walls->w[b];
+        char what[160];
+        if (w->shape == MF_SOLID_TANK)
+            snprintf(what, sizeof what, "past the %s wall of wall box %zu", faces[a][side],
+                     mf_scene_tank_number(sim, b));
+        else
+            snprintf(what, sizeof what, "inside obstacle '%s'", w->name);
         return MF_ERROR(MF_ERR_NUMERIC,
                         "unstable (throughWall) at time %g, step %ld: fluid particle "
-                        "id %lld at (%g %g %g) is past the %s wall of wall box %zu, "
-                        "moving at (%g %g %g) m/s",
-                        sim->time, sim->step, (long long)p->id[i], x[0], x[1], x[2],
-                        faces[a][side], b + 1, p->vel[3 * i], p->vel[3 * i + 1],
-                        p->vel[3 * i + 2]);
+                        "id %lld at (%g %g %g) is %s, moving at (%g %g %g) m/s",
+                        sim->time, sim->step, (long long)p->id[i], x[0], x[1], x[2], what,
+                        p->vel[3 * i], p->vel[3 * i + 1], p->vel[3 * i + 2]);
     }
     return 0;
 }
