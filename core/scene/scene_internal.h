@@ -19,7 +19,7 @@ int mf_scene_solid_init(const mf_sim *sim, const char *name, const mf_dict *d,
 int mf_scene_solid_add(mf_sim *sim, mf_wall *w, size_t first);
 
 /* Warn (naming the entry) when the lattice makes a shape of extent `want`
- * (m, per axis) into particles spanning more than half a spacing more or
+ * (m, per axis) into particles spanning half a spacing or more more or
  * less: the particles [first, sim->p->n) of kind `kind` (-1: any), their
  * span measured as the outermost centres plus l0. */
 void mf_scene_warn_extent(const mf_sim *sim, const char *where, const char *what,

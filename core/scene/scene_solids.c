@@ -90,10 +90,10 @@ void mf_scene_warn_extent(const mf_sim *sim, const char *where, const char *what
     static const char axes[] = "xyz";
     for (int a = 0; a < sim->dim; a++) {
         const double got = mx[a] - mn[a] + sim->l0;
-        if (fabs(got - want[a]) > 0.5 * sim->l0 * (1 + 1e-6))
+        if (fabs(got - want[a]) >= 0.5 * sim->l0 * (1 - 1e-6))
             mf_log_printf(sim->log, MF_LOG_QUIET,
                           "Warning: %s: %s '%s' is %g m along %c, but the lattice of l0 = %g "
-                          "makes it %g m (more than half a spacing off): make its size a "
+                          "makes it %g m (half a spacing or more off): make its size a "
                           "multiple of l0, or choose another particleSpacing\n",
                           where, what, name, want[a], axes[a], sim->l0, got);
     }
@@ -105,10 +105,10 @@ void mf_scene_warn_radius(const mf_sim *sim, const char *where, const char *what
     const double l0 = sim->l0;
     const double got = sim->dim == 2 ? sqrt((double)count * l0 * l0 / M_PI)
                                      : cbrt(3.0 * (double)count * l0 * l0 * l0 / (4 * M_PI));
-    if (fabs(got - radius) > 0.5 * l0 * (1 + 1e-6))
+    if (fabs(got - radius) >= 0.5 * l0 * (1 - 1e-6))
         mf_log_printf(sim->log, MF_LOG_QUIET,
                       "Warning: %s: %s '%s' has radius %g m, but its %zu particles of l0 = %g "
-                      "fill a %s of radius %g m (more than half a spacing off): choose a "
+                      "fill a %s of radius %g m (half a spacing or more off): choose a "
                       "finer particleSpacing\n",
                       where, what, name, radius, count, l0, sim->dim == 2 ? "disk" : "ball", got);
 }
