@@ -414,6 +414,45 @@ static void test_files(void)
     }
     mf_trimesh_free(&box);
 
+    /* PLY, ASCII and binary (the header checked before assimp reads it). */
+    static const char tetra_ascii[] =
+        "ply\nformat ascii 1.0\ncomment a unit tetrahedron\nelement vertex 4\n"
+        "property float x\nproperty float y\nproperty float z\n"
+        "element face 4\nproperty list uchar int vertex_indices\nend_header\n"
+        "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+    tmp_path(path, sizeof path, "tetra_ascii.ply");
+    write_text(path, tetra_ascii);
+    tmp_path(path, sizeof path, "tetra_binary.ply");
+    {
+        FILE *f = fopen(path, "wb");
+        CHECK(f != NULL);
+        if (f) {
+            fputs("ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float x\n"
+                  "property float y\nproperty float z\nelement face 4\n"
+                  "property list uchar int vertex_indices\nend_header\n", f);
+            const float v[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+            fwrite(v, sizeof v, 1, f);
+            const int32_t faces[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+            for (int k = 0; k < 4; k++) {
+                unsigned char three = 3;
+                fwrite(&three, 1, 1, f);
+                fwrite(faces[k], sizeof faces[k], 1, f);
+            }
+            fclose(f);
+        }
+    }
+    const char *plys[] = {"tetra_ascii.ply", "tetra_binary.ply"};
+    for (int k = 0; k < 2; k++) {
+        mf_trimesh m;
+        mf_trimesh_init(&m);
+        tmp_path(path, sizeof path, plys[k]);
+        int rc = mf_mesh_import(path, &m);
+        CHECK_MSG(rc == 0 && m.nverts == 4 && m.ntris == 4, "%s: rc %d, %zu vertices, %zu "
+                  "triangles: %s", plys[k], rc, m.nverts, m.ntris, mf_error_message());
+        mf_error_clear();
+        mf_trimesh_free(&m);
+    }
+
     /* Bad files: each error names the file and says what is wrong. */
     struct {
         const char *name, *content, *expect;
@@ -422,6 +461,12 @@ static void test_files(void)
         {"empty.stl", "", "empty"},
         {"garbage.stl", "this is not a polygon file\n", "assimp"},
         {"points.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\np 1\np 2\n", "no triangle"},
+        /* assimp's PLY reader ran for minutes on this header (fuzz_mesh) */
+        {"keyword.ply", "ply\nformat ascii 1.0\nelement vertex 4\nproper yoltfat x\n"
+                        "end_header\n0\n", "not a PLY header keyword"},
+        {"counts.ply", "ply\nformat ascii 1.0\nelement vertex 4000000000\nproperty float x\n"
+                       "end_header\n0\n", "need at least"},
+        {"noend.ply", "ply\nformat ascii 1.0\nelement vertex 1\n", "without end_header"},
     };
     for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
         tmp_path(path, sizeof path, bad[k].name);

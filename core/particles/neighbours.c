@@ -347,8 +347,8 @@ static int handle_class(mf_neighbours *nb, int handle, nb_handle **h, nb_class *
 
 int mf_neighbours_pairs(mf_neighbours *nb, const mf_particles *p, int handle, mf_pairs *out)
 {
-    nb_handle *h;
-    nb_class *c;
+    nb_handle *h = NULL;
+    nb_class *c = NULL;
     MF_CALL(handle_class(nb, handle, &h, &c));
     double d = 0;
     MF_CALL(refresh(nb, c, p, h->radius, &d));
@@ -388,8 +388,8 @@ int mf_neighbours_grid(mf_neighbours *nb, const mf_particles *p, double cell,
 int mf_neighbours_locality_order(mf_neighbours *nb, const mf_particles *p, int handle,
                                  size_t *perm)
 {
-    nb_handle *h;
-    nb_class *c;
+    nb_handle *h = NULL;
+    nb_class *c = NULL;
     MF_CALL(handle_class(nb, handle, &h, &c));
     const double t0 = now();
     c->list_radius = 0; /* the particles are about to move to other slots */

@@ -133,6 +133,9 @@ int mf_mesh_import(const char *path, mf_trimesh *out)
     if ((uintmax_t)st.st_size > MF_MESH_MAX_FILE_BYTES)
         return MF_ERROR(MF_ERR_INPUT, "%s: %jd bytes is more than the %zu GiB a polygon file may "
                         "have here", path, (intmax_t)st.st_size, MF_MESH_MAX_FILE_BYTES >> 30);
+    const char *dot = strrchr(path, '.');
+    if (strcasecmp(dot + 1, "ply") == 0)
+        MF_CALL(mf_ply_check_header(path, (size_t)st.st_size));
     /* No post-processing: assimp's own triangulation stops the process (an
      * assertion) on some broken files (found by fuzzing: an OFF file with a
      * bad face line). Polygons are split here instead (add_mesh, which also

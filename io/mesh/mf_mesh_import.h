@@ -21,6 +21,11 @@
  * regular file, of at most MF_MESH_MAX_FILE_BYTES. */
 int mf_mesh_import(const char *path, mf_trimesh *out);
 
+/* A PLY file's header checked against the format's grammar and its element
+ * counts against the file's size (ply_header.c), before assimp reads it:
+ * assimp's PLY reader runs for minutes on some broken headers. */
+int mf_ply_check_header(const char *path, size_t file_bytes);
+
 /* The reader the scene builder takes: `file` as written in a case, tried
  * as it is when absolute, else in the folder of the dictionary that names
  * it (constant/), then in its triSurface/ subfolder (OpenFOAM's place). */
