@@ -133,6 +133,10 @@ int mps_create_data(const mps_settings *s, mf_sim *sim, const mf_dict *solver_di
         return MF_ERROR(MF_ERR_MEMORY, "out of memory");
     *out = d;
     d->s = *s;
+    MF_CALL(mps_scheme_resolve(s, sim->dim, &d->sc));
+    d->s.collision = d->sc.collision;
+    d->density_scale = 1.0;
+    d->attempt_step = -1;
     MF_CALL(mf_kernel_init(&d->k_nd, sim->dim, sim->l0, s->re_number_density * sim->l0));
     MF_CALL(mf_kernel_init(&d->k_grad, sim->dim, sim->l0, s->re_gradient * sim->l0));
     MF_CALL(mf_kernel_init(&d->k_lap, sim->dim, sim->l0, s->re_laplacian * sim->l0));
@@ -163,6 +167,7 @@ int mps_create_data(const mps_settings *s, mf_sim *sim, const mf_dict *solver_di
                       "MPS kernel (%s): re = %g l0, n0 = %.6g, lambda = %.6g l0^2\n", names[k],
                       ks[k]->re / sim->l0, ks[k]->n0, ks[k]->lambda / (sim->l0 * sim->l0));
     mf_log_printf(sim->log, MF_LOG_NORMAL, "Pressure solver: %s\n", d->pressure.info->name);
+    mps_scheme_log(d, sim->log);
     return 0;
 }
 
@@ -188,6 +193,7 @@ void mps_destroy_data(mps_data *d)
     free(d->A.rowptr);
     free(d->A.col);
     free(d->A.val);
+    mps_scheme_free(d);
     free(d);
 }
 

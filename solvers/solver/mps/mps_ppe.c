@@ -109,6 +109,10 @@ typedef struct ppe_ctx {
     mf_rows rows;
     double c, dt, rho, n0, re;
     const double *rho_p, *pd, *n, *pressure;
+    const double *src; /* the scheme's source (mps_source.c), NULL: eq. 14 */
+    bool hl;           /* the higher-order Laplacian's weight (Khayyer & Gotoh 2010) */
+    bool walls_push;   /* wall unknowns' sources clipped at zero */
+    int dim;
     int avg;
     uint8_t *touches;
 } ppe_ctx;
@@ -121,7 +125,8 @@ typedef struct ppe_acc {
 static inline double ppe_coef(const void *ctx, const mf_pair *pr)
 {
     const ppe_ctx *c = ctx;
-    double cw = c->c * mf_weight(pr->len, c->re);
+    double cw = c->hl ? c->c * mf_weight_hl(pr->len, c->re, c->dim)
+                      : c->c * mf_weight(pr->len, c->re);
     if (c->rho_p)
         cw *= mf_inv_rho_pair(c->rho_p[pr->i], c->rho_p[pr->j], c->avg);
     return cw;
@@ -155,11 +160,13 @@ static bool ppe_row(const void *ctx, size_t i, size_t r)
     double *val = d->A.val;
     if (c->rho_p) {
         val[diag] = sum + d->s.compressibility / dt2;
-        d->rhs[r] = d->s.relaxation / dt2 * dn / c->n0;
+        d->rhs[r] = c->src ? c->src[i] : d->s.relaxation / dt2 * dn / c->n0;
     } else {
         val[diag] = sum + d->s.compressibility * c->rho / dt2;
-        d->rhs[r] = d->s.relaxation * c->rho / dt2 * dn / c->n0;
+        d->rhs[r] = c->src ? c->rho * c->src[i] : d->s.relaxation * c->rho / dt2 * dn / c->n0;
     }
+    if (c->walls_push && !d->is_fluid[i] && d->rhs[r] < 0)
+        d->rhs[r] = 0; /* surfaceDetection asymmetry: a wall pushes, never pulls */
     if (c->pd)
         d->rhs[r] += acc.known;
     c->touches[r] = acc.touches;
@@ -229,8 +236,20 @@ int mps_assemble_ppe(mps_data *d, const mf_sim *sim, double dt)
         .pressure = mf_particles_fd(p, d->f_pressure),
         .avg = d->rho_average,
         .touches = touches,
+        .dim = d->k_lap.dim,
+        .walls_push = d->sc.detection == MPS_DETECT_ASYMMETRY,
     };
-    int rc = mps_pairs(d, sim, d->h_lap, &c.v);
+    /* The scheme's source and Laplacian (a composing solver's per-particle
+     * density reference, MAFL's densityReference, keeps eq. 14's source). */
+    int rc = d->n_offset ? 0 : mps_source_terms(d, sim, dt);
+    if (rc == 0 && d->sc.source != MPS_SOURCE_DENSITY && !d->n_offset)
+        c.src = d->src;
+    if (d->sc.laplacian != MPS_LAPLACIAN_PAPER) { /* higherOrder, and leastSquares' PPE */
+        c.hl = true;
+        c.c = d->k_lap.hl_coef;
+    }
+    if (rc == 0)
+        rc = mps_pairs(d, sim, d->h_lap, &c.v);
     c.re = c.v.radius;
     size_t failed = SIZE_MAX;
     if (rc == 0)
