@@ -41,7 +41,6 @@ coarse() {
 
 known_stop() {
     case $1 in
-    damBreakObstacle) echo "issue 13 (schemes): the sheet that hits the far wall passes it at t = 0.31 s" ;;
     *) echo "" ;;
     esac
 }
