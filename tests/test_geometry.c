@@ -38,6 +38,7 @@
 #include "mf_error.h"
 #include "mf_mesh_import.h"
 #include "mf_scene.h"
+#include "mf_walls.h"
 #include "mf_test.h"
 #include "mf_trimesh.h"
 
@@ -221,7 +222,7 @@ static int scene_build(scene *s, const char *geometry_text)
 static void scene_free(scene *s)
 {
     mf_particles_destroy(s->sim.p);
-    free(s->sim.wall_boxes);
+    mf_walls_destroy(s->sim.walls);
     mf_dict_free(s->geometry);
     mf_dict_free(s->fluids);
     if (s->log_file)
@@ -934,7 +935,7 @@ static void test_warnings_and_errors(void)
         {"walls { w { type mesh; file \"empty.stl\"; } }", "empty"},
         {"walls { w { type mesh; file \"open.obj\"; side insde; } }", "did you mean 'inside'"},
         {"walls { w { type mesh; fiel \"open.obj\"; } }", "did you mean 'file'"},
-        {"obstacles { o { type box; min (0 0 0); max (1 1 1); } }", "type mesh"},
+        {"obstacles { o { type cylinder; centre (0.5 0.5 0.5); } }", "needs a centre and a radius"},
         {"fluidBlocks { f { type mesh; file \"open.obj\"; fluid watr; } }", "did you mean"},
     };
     for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
@@ -995,6 +996,141 @@ static void test_warnings_and_errors(void)
     mf_dict_free(g);
 }
 
+
+/* ---- solids: obstacles of every shape, prescribed motions, size warnings --- */
+
+/* The particles of solid k (WallId k + 1). */
+static size_t solid_particles(const scene *sc, size_t k, size_t *first)
+{
+    const mf_particles *p = sc->sim.p;
+    const int f = sc->sim.walls->f_wall_id;
+    size_t n = 0;
+    *first = SIZE_MAX;
+    for (size_t i = 0; f >= 0 && i < p->n; i++)
+        if (mf_particles_fi(p, f)[i] == (int32_t)k + 1) {
+            if (n++ == 0)
+                *first = i;
+        }
+    return n;
+}
+
+static void test_solids(void)
+{
+    scene sc;
+    /* A tank shaken sideways, a disk turning about its centre, a box on a
+     * table of positions, a fixed sphere: 2-D. */
+    const char *g =
+        "dimension 2; particleSpacing 0.01;"
+        "fluidBlocks { f { type box; min (0 0 0); max (0.4 0.1 0); fluid water; } }"
+        "walls { tank { type box; min (0 0 0); max (1 0.5 0); open (ymax);"
+        "  motion { type oscillating; amplitude (0.02 0 0); omega 3; } } }"
+        "obstacles {"
+        "  disk { type cylinder; centre (0.6 0.2 0); radius 0.05;"
+        "         motion { type rotation; origin (0.6 0.2 0); omega 2; } }"
+        "  block { type box; min (0.8 0 0); max (0.9 0.1 0);"
+        "          motion { type table; displacement ((0 (0 0 0)) (1 (0.1 0.05 0))); } }"
+        "  ball { type sphere; centre (0.6 0.4 0); radius 0.04; } }";
+    CHECK_MSG(scene_build(&sc, g) == 0, "%s", sc.error);
+    if (sc.rc != 0)
+        return;
+    mf_walls *ws = sc.sim.walls;
+    mf_particles *p = sc.sim.p;
+    CHECK(ws->n == 4 && ws->f_wall_id >= 0);
+    CHECK(ws->w[0].shape == MF_SOLID_TANK && ws->w[1].shape == MF_SOLID_CYLINDER &&
+          ws->w[2].shape == MF_SOLID_BOX && ws->w[3].shape == MF_SOLID_SPHERE);
+    CHECK(mf_walls_any_moving(ws) && !mf_wall_moves(&ws->w[3]));
+    /* Moving solids' particles carry their index; the block's 10 x 10 points
+     * less the 4 x 4 deeper than its three layers. */
+    size_t first[4], count[4];
+    for (size_t k = 0; k < 4; k++)
+        count[k] = solid_particles(&sc, k, &first[k]);
+    CHECK_MSG(count[0] > 0 && count[1] > 0 && count[2] == 84 && count[3] == 0,
+              "counts %zu %zu %zu %zu (a fixed solid is not tagged)", count[0], count[1],
+              count[2], count[3]);
+    double *x0 = malloc(3 * p->n * sizeof *x0);
+    memcpy(x0, p->pos, 3 * p->n * sizeof *x0);
+    const double t = 0.3;
+    CHECK(mf_walls_advance(ws, p, 0, 0.1) == 0);
+    CHECK(mf_walls_advance(ws, p, 0.1, t) == 0); /* in two steps: the moves compose */
+    const int32_t *id = mf_particles_fi(p, ws->f_wall_id);
+    double err_tank = 0, err_disk = 0, err_block = 0, err_v = 0, still = 0;
+    for (size_t i = 0; i < p->n; i++) {
+        const double *x = &p->pos[3 * i], *v = &p->vel[3 * i], *a = &x0[3 * i];
+        if (id[i] == 1) { /* x = x0 + A sin(omega t), v = A omega cos(omega t) */
+            err_tank = fmax(err_tank, fabs(x[0] - a[0] - 0.02 * sin(3 * t)) + fabs(x[1] - a[1]));
+            err_v = fmax(err_v, fabs(v[0] - 0.06 * cos(3 * t)) + fabs(v[1]));
+        } else if (id[i] == 2) { /* turned by omega t about the centre */
+            const double rx = a[0] - 0.6, ry = a[1] - 0.2, c = cos(2 * t), s_ = sin(2 * t);
+            const double ex = 0.6 + c * rx - s_ * ry, ey = 0.2 + s_ * rx + c * ry;
+            err_disk = fmax(err_disk, hypot(x[0] - ex, x[1] - ey));
+            err_v = fmax(err_v, hypot(v[0] + 2 * (x[1] - 0.2), v[1] - 2 * (x[0] - 0.6)));
+        } else if (id[i] == 3) { /* linear in the table: (0.1 0.05) t */
+            err_block = fmax(err_block, hypot(x[0] - a[0] - 0.1 * t, x[1] - a[1] - 0.05 * t));
+            err_v = fmax(err_v, hypot(v[0] - 0.1, v[1] - 0.05));
+        } else {
+            still = fmax(still, hypot(x[0] - a[0], x[1] - a[1]));
+        }
+    }
+    CHECK_MSG(err_tank < 1e-12 && err_disk < 1e-12 && err_block < 1e-12 && err_v < 1e-12 &&
+                  still == 0,
+              "moved: tank %g, disk %g, block %g, velocity %g, fixed and fluid %g", err_tank,
+              err_disk, err_block, err_v, still);
+    /* The watch's throughWall follows the solid: a point inside the moved
+     * block is inside it, the block's old place is free. */
+    int axis, side;
+    const double inside[3] = {0.85 + 0.1 * t, 0.05 + 0.05 * t, 0};
+    const double old[3] = {0.81, 0.01, 0};
+    CHECK(mf_wall_passed(&ws->w[2], 0.01, 2, inside, &axis, &side));
+    CHECK(!mf_wall_passed(&ws->w[2], 0.01, 2, old, &axis, &side));
+    CHECK(mf_walls_max_speed(ws, p) > 0.1);
+    free(x0);
+    scene_free(&sc);
+
+    /* A fluid block overlapping an obstacle is refused with both names. */
+    mf_dict *geometry = NULL;
+    const char *overlap =
+        "dimension 2; particleSpacing 0.01;"
+        "fluidBlocks { f { type box; min (0 0 0); max (0.4 0.2 0); fluid water; } }"
+        "walls { tank { type box; min (0 0 0); max (1 0.5 0); open (ymax); } }"
+        "obstacles { pillar { type cylinder; centre (0.2 0.1 0); radius 0.03; } }";
+    CHECK_MSG(scene_build(&sc, overlap) == 0, "%s", sc.error);
+    if (sc.rc == 0) {
+        geometry = sc.geometry;
+        int rc = mf_scene_check_start(geometry, &sc.sim);
+        const char *msg = rc ? mf_error_message() : "";
+        CHECK_MSG(rc != 0 && strstr(msg, "pillar") && strstr(msg, "fluid block 'f'") &&
+                      strstr(msg, "geometry:1:"),
+                  "rc %d: %s", rc, msg);
+        mf_error_clear();
+    }
+    scene_free(&sc);
+
+    /* The lattice snaps sizes: a 0.016 m step at l0 = 0.01 becomes 0.01 m,
+     * a 0.25 m column at 0.02 m becomes 0.24 m: half a spacing or more is
+     * said, naming the entry and its file:line; a 0.3 m block at 0.01 m is
+     * exact and says nothing. */
+    CHECK_MSG(scene_build(&sc, "dimension 2; particleSpacing 0.01;"
+                               "fluidBlocks { f { type box; min (0 0 0); max (0.3 0.2 0); "
+                               "fluid water; } }"
+                               "walls { tank { type box; min (0 0 0); max (1 0.5 0); } }"
+                               "obstacles { step { type box; min (0.5 0 0); max (0.516 0.1 0); } }")
+                  == 0, "%s", sc.error);
+    CHECK_MSG(strstr(sc.log_text, "Warning") && strstr(sc.log_text, "obstacle 'step'") &&
+                  strstr(sc.log_text, "geometry:1:") && strstr(sc.log_text, "along x"),
+              "log: %s", sc.log_text);
+    CHECK_MSG(!strstr(sc.log_text, "fluid block 'f'"), "log: %s", sc.log_text);
+    scene_free(&sc);
+    CHECK_MSG(scene_build(&sc, "dimension 2; particleSpacing 0.02;"
+                               "fluidBlocks { f { type box; min (0 0 0); max (0.25 0.5 0); "
+                               "fluid water; } }"
+                               "walls { tank { type box; min (0 0 0); max (1 0.6 0); } }")
+                  == 0, "%s", sc.error);
+    CHECK_MSG(strstr(sc.log_text, "fluid block 'f' is 0.25 m along x") &&
+                  strstr(sc.log_text, "makes it 0.24 m"),
+              "log: %s", sc.log_text);
+    scene_free(&sc);
+}
+
 int main(void)
 {
     snprintf(tmpdir, sizeof tmpdir, "/tmp/mpsflow-test-geometry-XXXXXX");
@@ -1019,6 +1155,7 @@ int main(void)
     test_meeting_meshes();
     test_units();
     test_warnings_and_errors();
+    test_solids();
 
     if (!getenv("MF_TEST_KEEP")) {
         char cmd[400];

@@ -18,6 +18,7 @@
 #include "mf_dictio.h"
 #include "mf_emitter.h"
 #include "mf_scene.h"
+#include "mf_walls.h"
 #include "mf_test.h"
 
 typedef struct scene {
@@ -40,7 +41,7 @@ static void destroy(scene *s)
 {
     mf_emitters_destroy(s->sim.emitters);
     mf_particles_destroy(s->sim.p);
-    free(s->sim.wall_boxes);
+    mf_walls_destroy(s->sim.walls);
     mf_dict_free(s->fluids);
     mf_dict_free(s->geometry);
 }

@@ -22,6 +22,7 @@
 #define MF_MAX_SCALARS 8
 
 struct mf_emitters; /* mf_emitter.h */
+struct mf_walls;    /* mf_walls.h */
 
 typedef struct mf_fluid {
     char name[64];
@@ -39,13 +40,6 @@ typedef struct mf_module {
     long calls;
     double seconds;
 } mf_module;
-
-/* A wall box as the scene built it: the region it encloses and which faces
- * are open. The run's watch uses it to see particles that pass a wall. */
-typedef struct mf_wall_box {
-    double min[3], max[3];
-    bool open[3][2];
-} mf_wall_box;
 
 /* ---- fault injection (tests) --------------------------------------------- */
 /* Where the calling wrappers (mf_modules.h) offer a test hook a chance to
@@ -95,9 +89,12 @@ typedef struct mf_sim {
      * shared by every module: a module requests its radius once
      * (mf_neighbours_request) and asks for the pairs when it loops. */
     mf_neighbours *neighbours;
-    /* Walls of the scene (box walls), for the watch. */
-    size_t nwall_boxes;
-    mf_wall_box *wall_boxes;
+    /* The solids of the scene (mf_walls.h: tanks, obstacles, mesh walls,
+     * their motions), built by the scene with or without their particles
+     * (wall_weight: without, for a solver that takes walls through wall
+     * weight functions; the driver sets it from the solver's settings). */
+    struct mf_walls *walls;
+    bool wall_weight;
     /* n0 of the solver's number density (0: the solver has none), for the watch. */
     double n0;
     /* Set by a solver that treats viscosity implicitly: the time loop then

@@ -48,6 +48,7 @@ typedef struct mf_watch {
     double ke0;          /* kinetic energy when the watch started */
     double work;         /* work of the force modules since then */
     double pot_scale;    /* sum m |a_ext| L at the start */
+    double wall_scale;   /* the largest 1/2 M u_w^2 so far: what moving walls can give the fluid */
     double n_start;      /* mean fluid number density at the first check (-1: not yet) */
     /* Candidate value of the step being checked (committed on accept). */
     double next_work;

@@ -12,6 +12,7 @@
 #include "mf_emitter.h"
 #include "mf_error.h"
 #include "mf_timestep.h"
+#include "mf_walls.h"
 
 size_t mf_peak_memory(void)
 {
@@ -177,7 +178,9 @@ static int choose_dt(mf_run *run, double next_write, double *dt, const char **li
         land_on_target(run, next_write, dt, land);
     } else {
         mf_dt_choice ch;
-        double umax = mf_max_fluid_speed(sim->p);
+        /* A moving wall limits the step as the fluid does: it must not
+         * cross more than maxCo spacings of fluid in one step. */
+        double umax = fmax(mf_max_fluid_speed(sim->p), mf_walls_max_speed(sim->walls, sim->p));
         mf_parallel_max(sim->par, &umax, 1); /* every rank takes the same step */
         mf_dt_choose(sim->l0, umax, c->max_co,
                      sim->viscosity_implicit ? 0.0 : max_fluid_nu(sim),
@@ -288,7 +291,11 @@ static int step_once(mf_run *run, saved_state *saved, double next_write)
         mf_log_printf(sim->log, MF_LOG_STEP, "deltaT = %g\n", dt);
         mf_log_printf(sim->log, MF_LOG_STEP, "Time = %.10g\n\n", sim->time + dt);
         double kinetic_in = 0;
-        int rc = apply_emitters(run, dt, &kinetic_in, &added, &removed);
+        /* Moving walls first, to where they are at the end of the step
+         * (mf_walls_advance); a retry restores their particles with the rest. */
+        int rc = mf_walls_advance(sim->walls, sim->p, saved->time, saved->time + dt);
+        if (rc == 0)
+            rc = apply_emitters(run, dt, &kinetic_in, &added, &removed);
         run->watch.work = work0 + kinetic_in;
         sim->forces_record.valid = false; /* set again by this attempt's forces */
         if (rc == 0)
@@ -307,6 +314,7 @@ static int step_once(mf_run *run, saved_state *saved, double next_write)
         if (!retry) {
             MF_CALL(restore_state(saved, sim->p));
             sim->time = saved->time;
+            mf_walls_set_time(sim->walls, sim->time); /* the walls where the particles are */
             return mf_error_trace(rc, __FILE__, __LINE__, __func__);
         }
         mf_log_printf(sim->log, MF_LOG_QUIET,

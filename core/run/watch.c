@@ -9,6 +9,7 @@
 #include "mf_error.h"
 #include "mf_modules.h"
 #include "mf_scene.h"
+#include "mf_walls.h"
 
 const mf_param mf_watch_params[] = {
     {"enabled", MF_PARAM_BOOL, "yes", MF_NO_RANGE, NULL, offsetof(mf_watch_settings, enabled),
@@ -59,8 +60,9 @@ static int check_non_finite(const mf_sim *sim)
 }
 
 /* A fluid centre past the wall-particle line (l0/2 outside the enclosed
- * region) of a closed face, within that face's extent, went through it
- * (mf_scene_past_wall: the dry run refuses a scene that starts so). */
+ * region) of a closed face, within that face's extent, or inside an
+ * obstacle by more than l0/2, went through it (mf_scene_past_wall: the dry
+ * run refuses a scene that starts so). */
 static int check_walls(const mf_sim *sim)
 {
     const mf_particles *p = sim->p;
@@ -71,13 +73,18 @@ static int check_walls(const mf_sim *sim)
         if (p->kind[i] != MF_FLUID || !mf_scene_past_wall(sim, i, &b, &a, &side))
             continue;
         const double *x = &p->pos[3 * i];
+        const mf_wall *w = &sim->walls->w[b];
+        char what[160];
+        if (w->shape == MF_SOLID_TANK)
+            snprintf(what, sizeof what, "past the %s wall of wall box %zu", faces[a][side],
+                     mf_scene_tank_number(sim, b));
+        else
+            snprintf(what, sizeof what, "inside obstacle '%s'", w->name);
         return MF_ERROR(MF_ERR_NUMERIC,
                         "unstable (throughWall) at time %g, step %ld: fluid particle "
-                        "id %lld at (%g %g %g) is past the %s wall of wall box %zu, "
-                        "moving at (%g %g %g) m/s",
-                        sim->time, sim->step, (long long)p->id[i], x[0], x[1], x[2],
-                        faces[a][side], b + 1, p->vel[3 * i], p->vel[3 * i + 1],
-                        p->vel[3 * i + 2]);
+                        "id %lld at (%g %g %g) is %s, moving at (%g %g %g) m/s",
+                        sim->time, sim->step, (long long)p->id[i], x[0], x[1], x[2], what,
+                        p->vel[3 * i], p->vel[3 * i + 1], p->vel[3 * i + 2]);
     }
     return 0;
 }
@@ -218,10 +225,31 @@ static size_t fastest_fluid(const mf_sim *sim, double *speed)
     return best;
 }
 
+/* The kinetic energy the fluid would have moving as fast as the fastest
+ * wall particle (a moving wall's, or a sliding lid's surface velocity): a
+ * moving wall does work on the fluid that no force module records (viscous
+ * drag of a lid, the push of a paddle), which a fluid set in motion by its
+ * walls may gain; 0 with walls at rest. */
+static double wall_energy(const mf_sim *sim)
+{
+    const mf_particles *p = sim->p;
+    const int ff = mf_particles_field_index(p, "FluidId");
+    double u2 = 0, mass = 0;
+    for (size_t i = 0; i < p->n_owned; i++) {
+        const double *v = &p->vel[3 * i];
+        if (p->kind[i] == MF_FLUID)
+            mass += mf_sim_particle_mass(sim, ff, i);
+        else
+            u2 = fmax(u2, v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    }
+    return 0.5 * mass * u2;
+}
+
 static int check_energy(mf_watch *w, const mf_sim *sim, double dt)
 {
     double ke = 0, power_start = 0, power_end = 0, mass_acc = 0;
     energy(sim, &ke, &power_start, &power_end, &mass_acc);
+    w->wall_scale = fmax(w->wall_scale, wall_energy(sim));
     if (!w->started) { /* the state the run starts from (after its first step) */
         w->started = true;
         w->ke0 = ke;
@@ -233,7 +261,7 @@ static int check_energy(mf_watch *w, const mf_sim *sim, double dt)
      * from u^n to u^{n+1}: the trapezoidal rule in u. */
     w->next_work = w->work + 0.5 * (power_start + power_end) * dt;
     double excess = ke - w->ke0 - w->next_work;
-    double scale = w->ke0 + fabs(w->next_work) + w->pot_scale;
+    double scale = w->ke0 + fabs(w->next_work) + w->pot_scale + w->wall_scale;
     if (!(scale > 0 && excess > w->s.energy_tolerance * scale))
         return 0;
     double speed = 0;

@@ -74,10 +74,14 @@ int mf_scene_check_overlap_in(const mf_dict *geometry, const mf_sim *sim);
  * inlet or nozzle, fluid past a closed wall face, an inlet, outlet or nozzle
  * that does not reach the walls' domain (scene_check.c). */
 int mf_scene_check_start(const mf_dict *geometry, const mf_sim *sim);
-/* True when fluid particle i is past a closed face of a wall box (the
- * wall-particle line, l0/2 outside the region), within that face's extent:
- * *box, *axis, *side (0 min, 1 max) say which. The watch's throughWall. */
+/* True when fluid particle i has gone through a solid (mf_wall_passed: past
+ * a closed face of a wall box by more than l0/2, within that face's extent,
+ * or inside an obstacle by more than l0/2): *box is the solid's index in
+ * sim->walls, *axis and *side (0 min, 1 max) the face of a wall box (-1
+ * otherwise). The watch's throughWall. */
 bool mf_scene_past_wall(const mf_sim *sim, size_t i, size_t *box, int *axis, int *side);
+/* The number of a wall box among the wall boxes (1 the first), for messages. */
+size_t mf_scene_tank_number(const mf_sim *sim, size_t wall);
 
 /* Index of a fluid by name, or an error listing the fluids. */
 int mf_scene_fluid_index(const mf_sim *sim, const char *name, int *index);
@@ -87,6 +91,8 @@ int mf_scene_fluid_index(const mf_sim *sim, const char *name, int *index);
  * the builder applies. */
 extern const mf_param_section mf_geometry_sections[];
 extern const size_t mf_geometry_nsections;
+extern const mf_param_section mf_solid_sections[]; /* obstacles: box, cylinder, sphere */
+extern const size_t mf_solid_nsections;
 extern const mf_param_section mf_mesh_sections[];
 extern const size_t mf_mesh_nsections;
 extern const mf_param_section mf_emitter_sections[];

@@ -11,6 +11,7 @@
 #include "mf_error.h"
 #include "mf_params.h"
 #include "mf_trimesh.h"
+#include "scene_internal.h"
 #include "scene_lattice.h"
 
 /* ---- fluids -------------------------------------------------------------- */
@@ -109,7 +110,7 @@ static const mf_param geometry_params[] = {
     {"emitters", MF_PARAM_DICT, NULL, MF_NO_RANGE, NULL, offsetof(geometry_settings, emitters),
      "named emitters (type nozzle): add fluid at a velocity and rate for a time window"},
     {"obstacles", MF_PARAM_DICT, NULL, MF_NO_RANGE, NULL, offsetof(geometry_settings, obstacles),
-     "named solid bodies in the fluid (type mesh: a polygon file, mf_trimesh.h)"},
+     "named solid bodies in the fluid: type box, cylinder, sphere or mesh (a polygon file)"},
 };
 static const char *const geometry_extra[] = {"FoamFile", NULL};
 #define NP(t) (sizeof(t) / sizeof((t)[0]))
@@ -164,7 +165,8 @@ typedef struct wall_settings {
     const char *type;
     double min[3], max[3];
     long wall_layers, dummy_layers;
-    const mf_dict *unused;
+    double velocity[3];
+    const mf_dict *motion;
 } wall_settings;
 
 static const mf_param wall_params[] = {
@@ -178,6 +180,10 @@ static const mf_param wall_params[] = {
      "layers of wall particles (in the pressure equation)"},
     {"dummyLayers", MF_PARAM_INT, "2", 0, 4, NULL, offsetof(wall_settings, dummy_layers),
      "outer layers of dummy particles (number density only)"},
+    {"velocity", MF_PARAM_VECTOR, "(0 0 0)", MF_NO_RANGE, NULL, offsetof(wall_settings, velocity),
+     "velocity of the wall's surface along itself, m/s (a sliding lid: the box stays)"},
+    {"motion", MF_PARAM_DICT, NULL, MF_NO_RANGE, NULL, offsetof(wall_settings, motion),
+     "prescribed rigid motion of the box (see geometry: <wall or obstacle>/motion)"},
 };
 static const char *const wall_extra[] = {"open", NULL};
 
@@ -289,12 +295,20 @@ static int add_fluid_block(mf_sim *sim, const char *name, const mf_dict *d, int 
     if (s.scalars)
         MF_CALL(mf_scene_block_scalars(sim, s.scalars, before, sim->p->n,
                                        out ? mf_dict_set_subdict(out, "scalars") : NULL));
-    if (sim->p->n == before) {
-        char where[512];
+    char where[512];
+    if (sim->p->n == before)
         return MF_ERROR(MF_ERR_INPUT,
                         "%s: fluid block '%s' is smaller than one particle spacing (%g): no "
                         "particle placed",
                         mf_loc_str(d->loc, where, sizeof where), name, l0);
+    mf_loc_str(d->loc, where, sizeof where);
+    if (sphere) {
+        mf_scene_warn_radius(sim, where, "fluid block", name, s.radius, sim->p->n - before);
+    } else if (s.wave_amplitude == 0) {
+        double want[3];
+        for (int a = 0; a < 3; a++)
+            want[a] = s.max[a] - s.min[a];
+        mf_scene_warn_extent(sim, where, "fluid block", name, want, before, MF_FLUID);
     }
     return 0;
 }
@@ -331,30 +345,41 @@ static int parse_open_faces(const mf_dict *d, const char *name, bool open[3][2])
     return 0;
 }
 
-static int record_wall_box(mf_sim *sim, const double *mn, const double *mx, bool open[3][2])
-{
-    if (mf_resize(&sim->wall_boxes, sim->nwall_boxes + 1, sizeof *sim->wall_boxes))
-        return MF_ERROR(MF_ERR_MEMORY, "out of memory");
-    mf_wall_box *b = &sim->wall_boxes[sim->nwall_boxes++];
-    memcpy(b->min, mn, sizeof b->min);
-    memcpy(b->max, mx, sizeof b->max);
-    memcpy(b->open, open, sizeof b->open);
-    if (sim->dim == 2) /* no z faces in 2-D */
-        b->open[2][0] = b->open[2][1] = true;
-    return 0;
-}
-
-/* A lattice point k steps outside the region is in layer k: the first
- * wallLayers are MF_WALL, the rest MF_DUMMY. */
+/* A wall box: a tank for the solids (mf_walls.h) and, with particle walls,
+ * its layers: a lattice point k steps outside the region is in layer k, the
+ * first wallLayers are MF_WALL, the rest MF_DUMMY. */
+static int add_wall_particles(mf_sim *sim, const wall_settings *ws, bool open[3][2]);
 static int add_wall_box(mf_sim *sim, const char *name, const mf_dict *d, mf_dict *resolved)
 {
     wall_settings s;
     mf_dict *out = resolved ? mf_dict_set_subdict(resolved, name) : NULL;
-    MF_CALL(mf_params_apply(wall_params, 5, d, wall_extra, &s, out));
+    MF_CALL(mf_params_apply(wall_params, NP(wall_params), d, wall_extra, &s, out));
     MF_CALL(mf_lattice_check_box("wall", name, d, s.min, s.max, sim->dim));
     bool open[3][2];
     MF_CALL(parse_open_faces(d, name, open));
-    MF_CALL(record_wall_box(sim, s.min, s.max, open));
+    mf_wall w;
+    MF_CALL(mf_scene_solid_init(sim, name, d, s.velocity, s.motion, MF_SOLID_TANK, false, &w));
+    memcpy(w.min, s.min, sizeof w.min);
+    memcpy(w.max, s.max, sizeof w.max);
+    memcpy(w.open, open, sizeof w.open);
+    if (sim->dim == 2) /* no z faces in 2-D */
+        w.open[2][0] = w.open[2][1] = true;
+    const size_t first = sim->p->n;
+    int rc = sim->wall_weight ? 0 : add_wall_particles(sim, &s, open);
+    if (rc == 0)
+        rc = mf_scene_solid_add(sim, &w, first);
+    if (rc != 0) {
+        mf_motion_free(&w.motion);
+        return mf_error_trace(rc, __FILE__, __LINE__, __func__);
+    }
+    return 0;
+}
+
+/* The wall box's particles: a lattice point k steps outside the region is
+ * in layer k. */
+static int add_wall_particles(mf_sim *sim, const wall_settings *ws, bool open[3][2])
+{
+    const wall_settings s = *ws;
     const double l0 = sim->l0;
     const long layers = s.wall_layers + s.dummy_layers;
     long lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1}, n[3] = {1, 1, 1};
@@ -429,12 +454,9 @@ static int visit_wall(mf_sim *sim, const char *name, const mf_dict *d, void *ctx
 static int visit_obstacle(mf_sim *sim, const char *name, const mf_dict *d, void *ctx)
 {
     build_ctx *c = ctx;
-    if (!mf_scene_entry_is_mesh(d)) {
-        char where[512];
-        return MF_ERROR(MF_ERR_INPUT, "%s: obstacle '%s': obstacles are `type mesh;` (a polygon "
-                        "file); a box of walls goes in walls", mf_loc_str(d->loc, where,
-                        sizeof where), name);
-    }
+    if (!mf_scene_entry_is_mesh(d))
+        return mf_scene_obstacle(sim, name, d,
+                                 c->resolved ? mf_dict_set_subdict(c->resolved, name) : NULL);
     return mf_scene_mesh_wall(c->meshes, sim, name, d, true,
                               c->resolved ? mf_dict_set_subdict(c->resolved, name) : NULL);
 }
@@ -519,6 +541,9 @@ static int build_scene(const mf_dict *geometry, double l0_override, mf_sim *sim,
     MF_CALL(mf_scene_meshes_create(geometry, reader, sim->dim, sim->l0, sim->log, &ctx->meshes));
     MF_CALL(check_budget(geometry, sim, ctx->meshes, budget));
     MF_CALL(mf_particles_create(sim->dim, 1024, &sim->p));
+    mf_walls_destroy(sim->walls);
+    sim->walls = NULL;
+    MF_CALL(mf_walls_create(sim->dim, sim->l0, !sim->wall_weight, &sim->walls));
     if (sim->nfluids > 1)
         MF_CALL(mf_particles_request_field(sim->p, "FluidId", 1, MF_FIELD_INT32, true,
                                            &ctx->fluid_field));
@@ -543,8 +568,9 @@ const mf_param_section mf_geometry_sections[] = {
      NP(geometry_params)},
     {"geometry: fluidBlocks/<name>, type box or sphere", "fluid particles on the lattice",
      block_params, NP(block_params)},
-    {"geometry: walls/<name>, type box", "layers of fixed particles around a region",
-     wall_params, NP(wall_params)},
+    {"geometry: walls/<name>, type box", "a tank: the closed faces of a box hold the fluid in "
+     "(`open (ymax)` lists faces without wall); with particle walls, layers of fixed particles "
+     "around the region", wall_params, NP(wall_params)},
 };
 const size_t mf_geometry_nsections = NP(mf_geometry_sections);
 const mf_param_section mf_fluid_sections[] = {

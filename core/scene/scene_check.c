@@ -17,32 +17,25 @@
 #include "mf_neighbours.h"
 #include "mf_pairs.h"
 #include "mf_scene.h"
+#include "mf_walls.h"
 
 bool mf_scene_past_wall(const mf_sim *sim, size_t i, size_t *box, int *axis, int *side)
 {
-    const mf_particles *p = sim->p;
-    const double h = 0.5 * sim->l0;
-    const double *x = &p->pos[3 * i];
-    for (size_t b = 0; b < sim->nwall_boxes; b++) {
-        const mf_wall_box *w = &sim->wall_boxes[b];
-        for (int a = 0; a < sim->dim; a++)
-            for (int s = 0; s < 2; s++) {
-                if (w->open[a][s])
-                    continue;
-                bool past = s == 0 ? x[a] < w->min[a] - h : x[a] > w->max[a] + h;
-                bool within = past;
-                for (int o = 0; o < sim->dim && within; o++)
-                    if (o != a && (x[o] < w->min[o] - h || x[o] > w->max[o] + h))
-                        within = false;
-                if (within) {
-                    *box = b;
-                    *axis = a;
-                    *side = s;
-                    return true;
-                }
-            }
-    }
+    const double *x = &sim->p->pos[3 * i];
+    for (size_t b = 0; sim->walls && b < sim->walls->n; b++)
+        if (mf_wall_passed(&sim->walls->w[b], sim->l0, sim->dim, x, axis, side)) {
+            *box = b;
+            return true;
+        }
     return false;
+}
+
+size_t mf_scene_tank_number(const mf_sim *sim, size_t wall)
+{
+    size_t k = 0;
+    for (size_t b = 0; b <= wall && b < sim->walls->n; b++)
+        k += sim->walls->w[b].shape == MF_SOLID_TANK;
+    return k;
 }
 
 /* ---- which entry of the geometry a point belongs to ---------------------- */
@@ -193,14 +186,57 @@ static int check_fluid_in_walls(const mf_dict *geometry, const mf_sim *sim)
             continue;
         const double *x = &p->pos[3 * i];
         char where[700];
-        const mf_wall_box *w = &sim->wall_boxes[b];
+        const mf_wall *w = &sim->walls->w[b];
+        if (w->shape != MF_SOLID_TANK)
+            continue; /* check_obstacles says more */
         return MF_ERROR(MF_ERR_INPUT,
                         "%s: fluid at (%g %g %g) is outside wall box %zu (%g %g %g) to (%g %g %g), "
                         "past its %s face: the run would stop at step 0 (throughWall). Move the "
                         "block inside the walls, or open that face",
                         locate(geometry, "fluidBlocks", "fluid block", x, sim, where, sizeof where),
-                        x[0], x[1], x[2], b + 1, w->min[0], w->min[1], w->min[2], w->max[0],
-                        w->max[1], w->max[2], faces[a][s]);
+                        x[0], x[1], x[2], mf_scene_tank_number(sim, b), w->min[0], w->min[1],
+                        w->min[2], w->max[0], w->max[1], w->max[2], faces[a][s]);
+    }
+    return 0;
+}
+
+/* Fluid closer than l0/2 to an obstacle's surface, or inside it: refused,
+ * naming both entries (a block that reaches into a body starts with a
+ * pressure spike, or with fluid inside the body). Polygon obstacles are
+ * checked through their particles (mf_scene_check_overlap_in), or, without
+ * particles, through their surface. */
+static int check_obstacles(const mf_dict *geometry, const mf_sim *sim)
+{
+    const mf_particles *p = sim->p;
+    for (size_t b = 0; sim->walls && b < sim->walls->n; b++) {
+        const mf_wall *w = &sim->walls->w[b];
+        if (!w->obstacle || (w->shape == MF_SOLID_MESH && !w->mesh))
+            continue;
+        size_t count = 0, first = 0;
+        double dmin = INFINITY;
+        for (size_t i = 0; i < p->n_owned; i++) {
+            if (p->kind[i] != MF_FLUID)
+                continue;
+            const double d = mf_wall_distance(w, &p->pos[3 * i], NULL);
+            if (d < 0.5 * sim->l0 * (1 - 1e-6)) {
+                if (count++ == 0 || d < dmin) {
+                    first = i;
+                    dmin = d;
+                }
+            }
+        }
+        if (count == 0)
+            continue;
+        const double *x = &p->pos[3 * first];
+        char where[700];
+        return MF_ERROR(MF_ERR_INPUT,
+                        "%s: %zu fluid particles overlap obstacle '%s' (%s), e.g. at (%g %g %g), "
+                        "%s %g m: fluid must stay l0/2 = %g m outside an obstacle. Move or "
+                        "shrink the block, or move the obstacle",
+                        locate(geometry, "fluidBlocks", "fluid block", x, sim, where, sizeof where),
+                        count, w->name, w->where, x[0], x[1], x[2],
+                        dmin < 0 ? "inside it by" : "from its surface,", fabs(dmin),
+                        0.5 * sim->l0);
     }
     return 0;
 }
@@ -229,7 +265,7 @@ static int check_some_fluid(const mf_dict *geometry, const mf_sim *sim)
 }
 
 /* The domain: the bounding box of the wall and dummy particles (box and mesh
- * walls alike), grown by one spacing. */
+ * walls alike) and of the tanks, grown by one spacing. */
 static bool domain_of(const mf_sim *sim, double mn[3], double mx[3])
 {
     const mf_particles *p = sim->p;
@@ -245,6 +281,16 @@ static bool domain_of(const mf_sim *sim, double mn[3], double mx[3])
         for (int a = 0; a < sim->dim; a++) {
             mn[a] = fmin(mn[a], p->pos[3 * i + a] - sim->l0);
             mx[a] = fmax(mx[a], p->pos[3 * i + a] + sim->l0);
+        }
+    }
+    for (size_t b = 0; sim->walls && b < sim->walls->n; b++) {
+        const mf_wall *w = &sim->walls->w[b];
+        if (w->shape != MF_SOLID_TANK)
+            continue;
+        any = true;
+        for (int a = 0; a < sim->dim; a++) {
+            mn[a] = fmin(mn[a], w->min[a] - sim->l0);
+            mx[a] = fmax(mx[a], w->max[a] + sim->l0);
         }
     }
     return any;
@@ -297,6 +343,7 @@ static int check_sources_reach(const mf_dict *geometry, const mf_sim *sim)
 
 int mf_scene_check_start(const mf_dict *geometry, const mf_sim *sim)
 {
+    MF_CALL(check_obstacles(geometry, sim));
     MF_CALL(mf_scene_check_overlap_in(geometry, sim));
     MF_CALL(check_some_fluid(geometry, sim));
     MF_CALL(check_fluid_in_walls(geometry, sim));

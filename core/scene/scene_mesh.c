@@ -21,6 +21,8 @@
 #include "mf_scene.h"
 #include "mf_trimesh.h"
 #include "trimesh_internal.h"
+#include "scene_internal.h"
+#include "walls_internal.h"
 
 /* Lattice indices are packed 21 bits per axis around this offset. */
 #define LAT_BITS 21
@@ -263,7 +265,7 @@ typedef struct mesh_settings {
     const char *type, *file, *side, *fluid;
     double scale, thickness, velocity[3];
     long wall_layers, dummy_layers;
-    const mf_dict *scalars;
+    const mf_dict *scalars, *motion;
 } mesh_settings;
 
 #define P_TYPE {"type", MF_PARAM_WORD, NULL, MF_NO_RANGE, mesh_type, \
@@ -280,7 +282,12 @@ typedef struct mesh_settings {
     {"dummyLayers", MF_PARAM_INT, "2", 0, 4, NULL, offsetof(mesh_settings, dummy_layers), \
      "layers of dummy particles behind them (number density only)"}, \
     {"thickness", MF_PARAM_SCALAR, "0", 0, 1e6, NULL, offsetof(mesh_settings, thickness), \
-     "side both: thickness of the solid slab, m (0: 2 (wallLayers + dummyLayers) l0)"}
+     "side both: thickness of the solid slab, m (0: 2 (wallLayers + dummyLayers) l0)"}, \
+    {"velocity", MF_PARAM_VECTOR, "(0 0 0)", MF_NO_RANGE, NULL, \
+     offsetof(mesh_settings, velocity), \
+     "velocity of the surface along itself, m/s (a belt: the shape stays)"}, \
+    {"motion", MF_PARAM_DICT, NULL, MF_NO_RANGE, NULL, offsetof(mesh_settings, motion), \
+     "prescribed rigid motion (see geometry: <wall or obstacle>/motion)"}
 
 static const mf_param wall_mesh_params[] = {
     P_TYPE, P_FILE, P_SCALE,
@@ -756,9 +763,30 @@ int mf_scene_mesh_wall(mf_scene_meshes *sm, mf_sim *sim, const char *name, const
         MF_CALL(mf_dict_set_number(resolved, "thickness", 2 * half));
     const double width = (mode == SIDE_BOTH ? half : (double)nlayers * l0) * (1 + 1e-9);
 
+    mf_wall solid;
+    MF_CALL(mf_scene_solid_init(sim, name, d, s.velocity, s.motion, MF_SOLID_MESH, obstacle,
+                                &solid));
+    const size_t first = sim->p->n;
+    int rc = 0;
+    if (sim->wall_weight) { /* the surface itself, kept for the run */
+        rc = mf_wall_mesh_create(&it->mesh, mode, out_sign, half, 4 * l0, sim->dim, &solid.mesh);
+        if (rc == 0)
+            rc = mf_scene_solid_add(sim, &solid, first);
+        if (rc == 0)
+            mf_log_printf(sm->log, MF_LOG_NORMAL,
+                          "%s mesh '%s': %s, %zu triangles, %s, side %s: wall weight, no "
+                          "particles\n", obstacle ? "Obstacle" : "Wall", name, it->mesh.name,
+                          it->mesh.ntris, r->closed ? "closed" : "open", side_names[mode]);
+        if (rc != 0) {
+            mf_motion_free(&solid.motion);
+            mf_wall_mesh_destroy(solid.mesh);
+        }
+        return rc;
+    }
+
     band b;
     memset(&b, 0, sizeof b);
-    int rc = band_build(&it->mesh, &it->pn, &sm->L, width, &b);
+    rc = band_build(&it->mesh, &it->pn, &sm->L, width, &b);
     uint64_t *keys = NULL;
     size_t nkeys = 0, nwall = 0, ndummy = 0;
     if (rc == 0) {
@@ -791,6 +819,10 @@ int mf_scene_mesh_wall(mf_scene_meshes *sm, mf_sim *sim, const char *name, const
     }
     free(keys);
     band_free(&b);
+    if (rc == 0)
+        rc = mf_scene_solid_add(sim, &solid, first);
+    if (rc != 0)
+        mf_motion_free(&solid.motion);
     MF_CALL(rc);
     if (nwall == 0)
         warn(sm, it, "no wall particle was placed (is the surface outside the domain, or, in "

@@ -9,6 +9,7 @@
 #include "mf_error.h"
 #include "mf_post.h"
 #include "mf_scene.h"
+#include "mf_walls.h"
 #include "mf_watch.h"
 
 const char *const mf_dict_table_names[] = {"controlDict", "watch",         "geometry",
@@ -35,8 +36,12 @@ static void each_section(const char *name, section_fn fn, FILE *f)
     } else if (!strcmp(name, "geometry")) {
         for (size_t k = 0; k < mf_geometry_nsections; k++)
             fn(&mf_geometry_sections[k], f);
+        for (size_t k = 0; k < mf_solid_nsections; k++)
+            fn(&mf_solid_sections[k], f);
         for (size_t k = 0; k < mf_mesh_nsections; k++)
             fn(&mf_mesh_sections[k], f);
+        for (size_t k = 0; k < mf_motion_nsections; k++)
+            fn(&mf_motion_sections[k], f);
         for (size_t k = 0; k < mf_emitter_nsections; k++)
             fn(&mf_emitter_sections[k], f);
     } else if (!strcmp(name, "fluids")) {

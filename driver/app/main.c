@@ -17,6 +17,7 @@
 #include "mf_app.h"
 #include "mf_error.h"
 #include "mf_post.h"
+#include "mf_walls.h"
 
 static void usage(FILE *f)
 {
@@ -226,6 +227,8 @@ static int run_case(mf_app *app)
         MF_CALL(w->read_latest(app->writer.data, &app->sim));
         mf_log_printf(&app->log, MF_LOG_NORMAL, "Restarting from time %g (step %ld)\n",
                       app->sim.time, app->sim.step);
+    } else if (app->sim.time != 0) { /* a fresh scene at startTime: solids where they are then */
+        MF_CALL(mf_walls_advance(app->sim.walls, app->sim.p, 0, app->sim.time));
     }
     MF_CALL(mf_parallel_agree(app->sim.par, mf_app_distribute(app)));
     if (mf_parallel_is_root(app->sim.par))

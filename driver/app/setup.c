@@ -8,6 +8,7 @@
 #include "mf_error.h"
 #include "mf_mesh_import.h"
 #include "mf_scene.h"
+#include "mf_walls.h"
 
 int mf_app_load_libs_text(mf_registry *reg, const char *text)
 {
@@ -293,7 +294,8 @@ void mf_app_teardown(mf_app *app)
         mf_module_release(&app->sim.forces[k]);
     }
     free(app->sim.forces);
-    free(app->sim.wall_boxes);
+    mf_walls_destroy(app->sim.walls);
+    app->sim.walls = NULL;
     mf_app_unwatch_control(app);
     mf_emitters_destroy(app->sim.emitters);
     app->sim.emitters = NULL;

@@ -218,28 +218,6 @@ static const mf_param osc_params[] = {
      "ignore the snapshots before this time, s"},
 };
 
-/* Times where q(t) crosses zero, either way, linearly interpolated. Zero is
- * the circle (sphere) at rest; the mean of q over the run is not, when the
- * amplitude decays. Successive crossings are half a period apart. */
-static size_t zero_crossings(const double *t, const double *q, size_t n, double *out)
-{
-    size_t m = 0;
-    for (size_t i = 1; i < n; i++) {
-        double a = q[i - 1], b = q[i];
-        if ((a < 0 && b >= 0) || (a > 0 && b <= 0))
-            out[m++] = t[i - 1] + (t[i] - t[i - 1]) * (-a) / (b - a);
-    }
-    return m;
-}
-
-/* The period from the zero crossings of q: 2 (t_last - t_first)/(n - 1). */
-static double crossing_period(const double *t, const double *q, size_t n, double *cross,
-                              size_t *nc)
-{
-    *nc = zero_crossings(t, q, n, cross);
-    return *nc >= 2 ? 2 * (cross[*nc - 1] - cross[0]) / (double)(*nc - 1) : NAN;
-}
-
 static int osc_evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
 {
     const char *case_dir = ctx->case_dir;
@@ -302,8 +280,8 @@ static int osc_evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *err
     if (cross && dext) {
         for (size_t k = 0; k < t.n; k++)
             dext[k] = t.col[2][k] - t.col[3][k];
-        period_ext = crossing_period(t.col[0], dext, t.n, cross, &ne);
-        period = crossing_period(t.col[0], t.col[1], t.n, cross, &nc);
+        period_ext = mf_crossing_period(t.col[0], dext, t.n, cross, &ne);
+        period = mf_crossing_period(t.col[0], t.col[1], t.n, cross, &nc);
     }
     if (rc == 0 && nc < 4)
         rc = MF_ERROR(MF_ERR_INPUT, "%s: the quadrupole moment crosses zero %zu time(s): run "

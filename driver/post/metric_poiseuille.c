@@ -11,7 +11,14 @@
  * first fluid and the first wall particle layer). For the newest snapshot
  * (time t): error = RMS over the fluid particles of (u_x - u(y, t)) /
  * u(L/2, t). The CSV lists every fluid particle (y, u_x, u) by y; the PNG
- * plots the profile against the analytic one. */
+ * plots the profile against the analytic one.
+ *
+ * The same file holds metric couette (tutorials/couette2D): the start-up of
+ * the flow between a fixed plate at y = 0 and a lid at y = L sliding at U,
+ * the fluid at rest at t = 0 (Morris, Fox & Zhu 1997, eq. 22):
+ *   u(y, t) = U y / L + sum_{n>=1} 2 U (-1)^n / (n pi) sin(n pi y / L)
+ *                          exp(-n^2 pi^2 nu t / L^2),
+ * error = RMS over the fluid particles of (u_x - u(y, t)) / U. */
 #include <math.h>
 #include <stddef.h>
 #include <stdlib.h>
@@ -25,6 +32,7 @@
 typedef struct poiseuille_settings {
     const char *metric;
     double force, nu, gap, bottom;
+    double lid; /* couette: the lid's speed U (force unused) */
 } poiseuille_settings;
 
 static const mf_param poiseuille_params[] = {
@@ -40,6 +48,19 @@ static const mf_param poiseuille_params[] = {
      "y of the lower plate, m"},
 };
 static const char *const poiseuille_extra[] = {"FoamFile", NULL};
+
+static const mf_param couette_params[] = {
+    {"metric", MF_PARAM_WORD, NULL, MF_NO_RANGE, NULL, offsetof(poiseuille_settings, metric),
+     "couette"},
+    {"lidVelocity", MF_PARAM_SCALAR, NULL, -1e9, 1e9, NULL, offsetof(poiseuille_settings, lid),
+     "the speed U of the upper plate along x, m/s"},
+    {"nu", MF_PARAM_SCALAR, NULL, 1e-12, 1e9, NULL, offsetof(poiseuille_settings, nu),
+     "kinematic viscosity, m^2/s"},
+    {"gap", MF_PARAM_SCALAR, NULL, 1e-12, 1e9, NULL, offsetof(poiseuille_settings, gap),
+     "distance L between the plates, m"},
+    {"bottom", MF_PARAM_SCALAR, "0", -1e9, 1e9, NULL, offsetof(poiseuille_settings, bottom),
+     "y of the lower (fixed) plate, m"},
+};
 
 /* The analytic velocity at height y above the lower plate, time t. */
 static double poiseuille_u(const poiseuille_settings *s, double y, double t)
@@ -58,6 +79,48 @@ static double poiseuille_u(const poiseuille_settings *s, double y, double t)
     return u;
 }
 
+/* Couette start-up (Morris et al. 1997, eq. 22). */
+static double couette_u(const poiseuille_settings *s, double y, double t)
+{
+    const double U = s->lid, nu = s->nu, L = s->gap;
+    double u = U * y / L;
+    for (int n = 1; n <= 400; n++) {
+        const double decay = exp(-n * n * M_PI * M_PI * nu * t / (L * L));
+        const double term = 2.0 * U * (n % 2 ? -1.0 : 1.0) / (n * M_PI) * sin(n * M_PI * y / L) *
+                            decay;
+        u += term;
+        if (decay < 1e-17 && n > 3)
+            break;
+    }
+    return u;
+}
+
+typedef struct channel_flow {
+    const char *name;             /* for the report */
+    const char *reference;        /* the analytic solution's source */
+    const mf_param *params;
+    size_t nparams;
+    double (*u)(const poiseuille_settings *s, double y, double t);
+    double (*scale)(const poiseuille_settings *s, double t); /* the error's denominator */
+} channel_flow;
+
+static double poiseuille_scale(const poiseuille_settings *s, double t)
+{
+    return poiseuille_u(s, 0.5 * s->gap, t);
+}
+static double couette_scale(const poiseuille_settings *s, double t)
+{
+    (void)t;
+    return s->lid;
+}
+
+static const channel_flow poiseuille_flow = {
+    "Poiseuille", "Morris et al. (1997) eq. 21", poiseuille_params,
+    sizeof poiseuille_params / sizeof poiseuille_params[0], poiseuille_u, poiseuille_scale};
+static const channel_flow couette_flow = {
+    "Couette", "Morris et al. (1997) eq. 22", couette_params,
+    sizeof couette_params / sizeof couette_params[0], couette_u, couette_scale};
+
 typedef struct sample {
     double y, u, exact;
 } sample;
@@ -68,8 +131,9 @@ static int by_y(const void *a, const void *b)
     return (p->y > q->y) - (p->y < q->y);
 }
 
-static int write_report(const char *out_dir, const poiseuille_settings *s, const sample *pts,
-                        size_t n, double t, double error, double umax)
+static int write_report(const char *out_dir, const channel_flow *flow,
+                        const poiseuille_settings *s, const sample *pts, size_t n, double t,
+                        double error, double umax)
 {
     double *col[3];
     for (int c = 0; c < 3; c++) {
@@ -87,22 +151,27 @@ static int write_report(const char *out_dir, const poiseuille_settings *s, const
     }
     char path[4400], comment[1024];
     snprintf(path, sizeof path, "%s/result.csv", out_dir);
-    snprintf(comment, sizeof comment,
-             "Poiseuille start-up: F = %g m/s^2, nu = %g m^2/s, L = %g m, time %g s, %zu fluid "
-             "particles\nexact: Morris, Fox & Zhu (1997) eq. 21; centre-line speed %g m/s\n"
-             "RMS of (u - u_exact)/u_centre = %.6g",
-             s->force, s->nu, s->gap, t, n, umax, error);
+    if (flow == &couette_flow)
+        snprintf(comment, sizeof comment,
+                 "Couette start-up: U = %g m/s, nu = %g m^2/s, L = %g m, time %g s, %zu fluid "
+                 "particles\nexact: %s\nRMS of (u - u_exact)/U = %.6g",
+                 s->lid, s->nu, s->gap, t, n, flow->reference, error);
+    else
+        snprintf(comment, sizeof comment,
+                 "Poiseuille start-up: F = %g m/s^2, nu = %g m^2/s, L = %g m, time %g s, %zu "
+                 "fluid particles\nexact: %s; centre-line speed %g m/s\n"
+                 "RMS of (u - u_exact)/u_centre = %.6g",
+                 s->force, s->nu, s->gap, t, n, flow->reference, umax, error);
     const double *const cols[3] = {col[0], col[1], col[2]};
     int rc = mf_report_csv(path, comment, "y,u,u_exact", 3, cols, n);
     if (rc == 0) {
         snprintf(path, sizeof path, "%s/result.png", out_dir);
         char title[256];
-        snprintf(title, sizeof title, "Poiseuille start-up at t = %g s (relative RMS error %.3g)",
-                 t, error);
+        snprintf(title, sizeof title, "%s start-up at t = %g s (relative RMS error %.3g)",
+                 flow->name, t, error);
         mf_plot plot = {title, "y, m", "u_x, m/s", false, false, NULL};
         mf_series series[2] = {{"mpsflow", col[0], col[1], n, "points pt 7 ps 0.5", NULL},
-                               {"Morris et al. (1997) eq. 21", col[0], col[2], n, "lines lw 2",
-                                NULL}};
+                               {flow->reference, col[0], col[2], n, "lines lw 2", NULL}};
         rc = mf_report_plot(path, &plot, series, 2);
     }
     for (int c = 0; c < 3; c++)
@@ -110,13 +179,13 @@ static int write_report(const char *out_dir, const poiseuille_settings *s, const
     return rc;
 }
 
-static int evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
+static int evaluate_flow(const channel_flow *flow, const mf_metric_ctx *ctx, const mf_dict *md,
+                         double *error)
 {
     const char *case_dir = ctx->case_dir;
     poiseuille_settings s;
-    MF_CALL(mf_params_apply(poiseuille_params,
-                            sizeof poiseuille_params / sizeof poiseuille_params[0], md,
-                            poiseuille_extra, &s, NULL));
+    memset(&s, 0, sizeof s);
+    MF_CALL(mf_params_apply(flow->params, flow->nparams, md, poiseuille_extra, &s, NULL));
     int *idx = NULL;
     size_t nsnap = 0;
     MF_CALL(mf_metric_snapshots(ctx, &idx, &nsnap));
@@ -128,12 +197,12 @@ static int evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
     MF_CALL(mf_hdf5_read_snapshot(path, &snap));
     const mf_particles *p = snap.p;
     const double t = snap.time;
-    const double umax = poiseuille_u(&s, 0.5 * s.gap, t);
+    const double umax = flow->scale(&s, t);
     int rc = 0;
     if (!(fabs(umax) > 0))
         rc = MF_ERROR(MF_ERR_INPUT,
-                      "%s: the analytic centre-line speed is 0 at t = %g s (bodyForce 0, or "
-                      "the initial snapshot): nothing to compare",
+                      "%s: the analytic speed scale is 0 at t = %g s (bodyForce or lidVelocity "
+                      "0, or the initial snapshot): nothing to compare",
                       path, t);
     sample *pts = rc == 0 ? malloc((p->n ? p->n : 1) * sizeof *pts) : NULL;
     if (rc == 0 && !pts)
@@ -146,7 +215,7 @@ static int evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
         sample *q = &pts[n++];
         q->y = p->pos[3 * i + 1] - s.bottom;
         q->u = p->vel[3 * i];
-        q->exact = poiseuille_u(&s, q->y, t);
+        q->exact = flow->u(&s, q->y, t);
         const double e = (q->u - q->exact) / umax;
         sum += e * e;
     }
@@ -159,12 +228,28 @@ static int evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
     }
     if (rc == 0) {
         qsort(pts, n, sizeof *pts, by_y);
-        rc = write_report(ctx->out_dir, &s, pts, n, t, *error, umax);
+        rc = write_report(ctx->out_dir, flow, &s, pts, n, t, *error, umax);
     }
     free(pts);
     mf_particles_destroy(snap.p);
     return rc;
 }
+
+static int evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
+{
+    return evaluate_flow(&poiseuille_flow, ctx, md, error);
+}
+
+static int evaluate_couette(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
+{
+    return evaluate_flow(&couette_flow, ctx, md, error);
+}
+
+const mf_metric mf_metric_couette = {
+    "couette",
+    "start-up of plane Couette flow (a sliding lid) against Morris et al. (1997) eq. 22 "
+    "(RMS of u over the lid speed)",
+    evaluate_couette, couette_params, sizeof couette_params / sizeof couette_params[0]};
 
 const mf_metric mf_metric_poiseuille = {
     "poiseuille",

@@ -60,6 +60,10 @@ extern const mf_metric mf_metric_hydrostatic;
 
 /* Linear interpolation of y(x) at xq on ascending x; NAN outside. */
 double mf_interp(const double *x, const double *y, size_t n, double xq);
+/* The period of an oscillation q(t) (n samples) from its zero crossings:
+ * 2 (t_last - t_first)/(crossings - 1), NAN with fewer than two; cross (n
+ * entries) receives the crossing times, *nc their count. */
+double mf_crossing_period(const double *t, const double *q, size_t n, double *cross, size_t *nc);
 /* Read a two-column CSV with '#' comments and one header line. */
 int mf_read_csv2(const char *path, double **a, double **b, size_t *n);
 

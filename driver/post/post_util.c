@@ -68,3 +68,23 @@ int mf_read_csv2(const char *path, double **a, double **b, size_t *n)
     }
     return rc;
 }
+
+/* Times where q(t) crosses zero, either way, linearly interpolated. Zero is
+ * the state at rest; the mean of q over the run is not, when the amplitude
+ * decays. Successive crossings are half a period apart. */
+static size_t zero_crossings(const double *t, const double *q, size_t n, double *out)
+{
+    size_t m = 0;
+    for (size_t i = 1; i < n; i++) {
+        double a = q[i - 1], b = q[i];
+        if ((a < 0 && b >= 0) || (a > 0 && b <= 0))
+            out[m++] = t[i - 1] + (t[i] - t[i - 1]) * (-a) / (b - a);
+    }
+    return m;
+}
+
+double mf_crossing_period(const double *t, const double *q, size_t n, double *cross, size_t *nc)
+{
+    *nc = zero_crossings(t, q, n, cross);
+    return *nc >= 2 ? 2 * (cross[*nc - 1] - cross[0]) / (double)(*nc - 1) : NAN;
+}

@@ -15,6 +15,7 @@
 #include "mf_mesh_import.h"
 #include "mf_particles.h"
 #include "mf_scene.h"
+#include "mf_walls.h"
 #include "mf_trimesh.h"
 
 int LLVMFuzzerInitialize(int *argc, char ***argv)
@@ -49,7 +50,7 @@ static void build_scene(const char *path, const char *role, double l0)
         mf_scene_build_with_reader(geometry, 0, &sim, NULL, &reader) == 0)
         mf_scene_check_overlap(&sim);
     mf_error_clear();
-    free(sim.wall_boxes);
+    mf_walls_destroy(sim.walls);
     mf_particles_destroy(sim.p);
     fclose(null);
     mf_dict_free(geometry);
