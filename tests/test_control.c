@@ -24,6 +24,12 @@
  *                   nothing (no field, no pass, no change of the solver's
  *                   neighbour lists or their order).
  *
+ *   shapes          (no run) a closed OBJ box, read through core/scene's mesh
+ *                   import and sampled on the lattice, holds the same lattice
+ *                   points as the box shape; a sphere's level-set offset grows
+ *                   it by the offset; a point is sampled by one control
+ *                   particle at its centre.
+ *
  * argv[1]: mpsflow; argv[2]: tutorials/directedSplash. */
 #include <math.h>
 #include <stdio.h>
@@ -31,6 +37,8 @@
 #include <string.h>
 
 #include "case_util.h"
+#include "force/control/control_shape.h"
+#include "mf_mesh_import.h"
 #include "mf_test.h"
 
 #define L0 0.02
@@ -357,12 +365,101 @@ static void check_path(const char *exe)
     tc_case_destroy(&c);
 }
 
+/* ---- the shapes ---------------------------------------------------------------- */
+
+/* A closed box [lo, hi] as an OBJ file, its faces wound outward. */
+static void write_obj_box(const char *path, const double lo[3], const double hi[3])
+{
+    FILE *f = fopen(path, "w");
+    CHECK(f != NULL);
+    if (!f)
+        return;
+    for (int k = 0; k < 8; k++)
+        fprintf(f, "v %g %g %g\n", k & 1 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1],
+                k & 4 ? hi[2] : lo[2]);
+    static const int quads[6][4] = {{1, 3, 4, 2}, {5, 6, 8, 7}, {1, 2, 6, 5},
+                                    {3, 7, 8, 4}, {1, 5, 7, 3}, {2, 4, 8, 6}};
+    for (int q = 0; q < 6; q++)
+        fprintf(f, "f %d %d %d\nf %d %d %d\n", quads[q][0], quads[q][1], quads[q][2],
+                quads[q][0], quads[q][2], quads[q][3]);
+    fclose(f);
+}
+
+static void check_shapes(const char *exe)
+{
+    tc_case c;
+    CHECK_OK(tc_case_create(&c, exe, "control-shapes"));
+    char obj[700], geometry[700];
+    snprintf(obj, sizeof obj, "%s/constant/target.obj", c.dir);
+    snprintf(geometry, sizeof geometry, "%s/constant/geometry", c.dir);
+    const double lo[3] = {0.3, 0.2, -0.1}, hi[3] = {0.6, 0.5, 0.1};
+    write_obj_box(obj, lo, hi);
+    const mf_trimesh_reader reader = mf_mesh_import_reader();
+    mf_log log;
+    mf_log_init(&log, stdout, MF_LOG_QUIET);
+    mf_sim sim = {.dim = 2, .l0 = 0.01, .log = &log, .mesh_reader = &reader,
+                  .mesh_relative_to = geometry};
+    control_shape_settings s = {.shape = "mesh", .file = "target.obj", .scale = 1,
+                                .radius = 0.1, .offset = 0};
+    control_shape mesh, box, sphere, grown, point;
+    CHECK_OK(control_shape_create(&s, "test", &sim, &mesh));
+    s.shape = "box";
+    memcpy(s.min, lo, sizeof lo);
+    memcpy(s.max, hi, sizeof hi);
+    CHECK_OK(control_shape_create(&s, "test", &sim, &box));
+    s.shape = "sphere";
+    s.centre[0] = 0.45;
+    s.centre[1] = 0.35;
+    s.centre[2] = 0;
+    CHECK_OK(control_shape_create(&s, "test", &sim, &sphere));
+    s.offset = 0.05;
+    CHECK_OK(control_shape_create(&s, "test", &sim, &grown));
+    s.shape = "point";
+    s.offset = 0;
+    CHECK_OK(control_shape_create(&s, "test", &sim, &point));
+    size_t agree = 0, inside = 0, total = 0, sphere_bad = 0;
+    for (int j = 0; j < 70; j++)
+        for (int i = 0; i < 90; i++) {
+            const double x[3] = {(i + 0.5) * 0.01, (j + 0.5) * 0.01, 0};
+            const bool m = control_shape_contains(&mesh, x, NULL);
+            agree += m == control_shape_contains(&box, x, NULL);
+            inside += m;
+            total++;
+            const double r = hypot(x[0] - 0.45, x[1] - 0.35);
+            sphere_bad += control_shape_contains(&sphere, x, NULL) != (r < 0.1);
+            sphere_bad += control_shape_contains(&grown, x, NULL) != (r < 0.15);
+        }
+    printf("shapes: the OBJ box holds %zu lattice points, the same as the box shape at %zu of "
+           "%zu; sphere and grown sphere wrong at %zu\n", inside, agree, total, sphere_bad);
+    CHECK(inside == 30 * 30);
+    CHECK(agree == total);
+    CHECK(sphere_bad == 0);
+    double xyz[6];
+    CHECK(control_shape_lattice(&point, 0.02, xyz, 2) == 1 && xyz[0] == 0.45 && xyz[1] == 0.35);
+    CHECK(control_shape_lattice(&box, 0.02, NULL, 0) == 15 * 15);
+    CHECK(control_shape_lattice(&mesh, 0.02, NULL, 0) == 15 * 15);
+    /* A mesh with an offset is refused, saying why. */
+    s.shape = "mesh";
+    s.offset = 0.01;
+    control_shape bad;
+    CHECK(control_shape_create(&s, "test", &sim, &bad) == MF_ERR_INPUT);
+    CHECK(strstr(mf_error_message(), "offset") != NULL);
+    control_shape_free(&bad);
+    control_shape_free(&mesh);
+    control_shape_free(&box);
+    control_shape_free(&sphere);
+    control_shape_free(&grown);
+    control_shape_free(&point);
+    tc_case_destroy(&c);
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 3) {
         fprintf(stderr, "usage: test_control MPSFLOW TUTORIAL_DIRECTEDSPLASH\n");
         return 2;
     }
+    check_shapes(argv[1]);
     check_velocity_region(argv[1]);
     check_path(argv[1]);
     check_directed_splash(argv[1], argv[2]);
