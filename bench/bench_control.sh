@@ -11,7 +11,7 @@ cd "${0%/*}/.." || exit 1
 l0=${1:-0.01}
 exe=$PWD/build/driver/mpsflow
 [ -x "$exe" ] || { echo "build first: ./Allwmake"; exit 1; }
-export OMP_NUM_THREADS=1
+export OMP_NUM_THREADS=1 OMP_WAIT_POLICY=PASSIVE # no re-exec under valgrind
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 mk() { # NAME: a copy of the tutorial with its forces block as $2
@@ -39,14 +39,14 @@ mkdir -p bench/results
     done
     if command -v valgrind > /dev/null; then
         echo
-        echo "Instructions of a 0.1 s run (callgrind, whole process):"
+        echo "Instructions of a 0.05 s run (callgrind, whole process):"
         echo
         echo "| run | instructions |"
         echo "|---|---|"
         for c in uncontrolled controlled away; do
             rm -rf "$tmp/$c/output"
             valgrind --tool=callgrind --callgrind-out-file="$tmp/cg.$c" "$exe" -case "$tmp/$c" \
-                -l0 "$l0" -endTime 0.1 > "$tmp/$c.cg.log" 2>&1
+                -l0 "$l0" -endTime 0.05 > "$tmp/$c.cg.log" 2>&1
             ir=$(sed -n 's/^summary: //p' "$tmp/cg.$c")
             echo "| $c | $ir |"
         done
