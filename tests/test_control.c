@@ -209,9 +209,11 @@ static void check_directed_splash(const char *exe, const char *tutorial)
     free(plain);
     free(ref_solver);
     free(away_solver);
-    bool ok = run_case(&ctl, "directedSplash") & run_case(&unc, "directedSplash uncontrolled") &
-              run_case(&ref, "the plain scene") & run_case(&away, "control forces away");
-    if (ok) {
+    const bool ran[4] = {run_case(&ctl, "directedSplash"),
+                         run_case(&unc, "directedSplash uncontrolled"),
+                         run_case(&ref, "the plain scene"),
+                         run_case(&away, "control forces away")};
+    if (ran[0] && ran[1] && ran[2] && ran[3]) {
         const double lo[2] = {0.75, 0.25}, hi[2] = {1.0, 0.45};
         const double fc = last_fraction(&ctl, lo, hi), fu = last_fraction(&unc, lo, hi);
         printf("attraction: fluid inside the target at the end: %.4f controlled, %.4f "
@@ -285,7 +287,8 @@ static void check_velocity_region(const char *exe)
                                   pool_geometry));
     CHECK_OK(tc_case_from_strings(&b, exe, "control-vregion-free", control, without, fluids,
                                   pool_geometry));
-    if (run_case(&a, "velocityRegion") & run_case(&b, "pool")) {
+    const bool ran_a = run_case(&a, "velocityRegion"), ran_b = run_case(&b, "pool");
+    if (ran_a && ran_b) {
         const double lo[2] = {0.4, 0.08}, hi[2] = {0.6, 0.22};
         double ua[2], ub[2];
         size_t na, nb;
