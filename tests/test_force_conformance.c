@@ -51,6 +51,11 @@ static const char *dt_settings(const char *force)
         return "dtFactor 0.01;"; /* 4.8e-4 s with water's sigma at l0 = 0.01 m */
     if (strcmp(force, "fault") == 0)
         return "stableDt 4e-4;";
+    /* the control forces: 1 / rate = 5e-4 s */
+    if (strcmp(force, "attraction") == 0)
+        return "velocityAlignment 2000;";
+    if (strcmp(force, "velocityRegion") == 0 || strcmp(force, "pathFollow") == 0)
+        return "rate 2000;";
     return "";
 }
 

@@ -67,6 +67,35 @@ u=$(tail -n 1 "$case/postProcessing/momentum/momentum.dat")
 check "the pushed column rises at a - g: mean u_y (a - g) t = 0.5095 m/s at t = 0.05 ($u)" \
     "echo '$u' | awk '{ exit !(\$1 == 0.05 && \$3 > 0.5095 * 0.98 && \$3 < 0.5095 * 1.02) }'"
 
+# ---- the plugin example's second module: a user-written control force --------------
+# plugins/regionLift (README.md there), built outside the tree like the two
+# above. Its box around the column lifts it as uniformPush does (a - g);
+# the box beside the column leaves it to fall (mean u_y < 0).
+cc -std=c11 -Wall -Wextra -Werror $(pkg --cflags) -shared -fPIC -o "$tmp/plugins/libregionLift.so" \
+    "$src/plugins/regionLift/regionLift.c" > "$tmp/log.cc.regionLift" 2>&1
+check "libregionLift.so (plugins/regionLift) builds outside the tree" \
+    "[ -s '$tmp/plugins/libregionLift.so' ]" || cat "$tmp/log.cc.regionLift"
+for where in column beside; do
+    case=$tmp/lift-$where
+    cp -r "$prefix/share/mpsflow/tutorials/damBreak2D" "$case"
+    sed -i 's/^libs .*/libs ("libkineticEnergy.so" "libregionLift.so" "libfluidMomentum.so");/' \
+        "$case/system/controlDict"
+    sed -i '/^functions$/{n;a\    momentum { type fluidMomentum; }
+}' "$case/system/controlDict"
+    if [ $where = column ]; then box='min (-0.1 -0.1 0); max (0.4 0.7 0);'
+    else box='min (1.0 0 0); max (2.0 0.6 0);'; fi
+    sed -i "/^forces\$/{n;a\    lift { type regionLift; $box acceleration (0 20 0); }
+}" "$case/system/solverDict"
+    MPSFLOW_PLUGIN_PATH=$tmp/plugins "$exe" -case "$case" -l0 0.02 -endTime 0.05 > "$case/log" 2>&1 ||
+        tail -n 20 "$case/log"
+done
+u=$(tail -n 1 "$tmp/lift-column/postProcessing/momentum/momentum.dat" 2>/dev/null)
+check "regionLift's box around the column: it rises at a - g, 0.5095 m/s at t = 0.05 ($u)" \
+    "echo '$u' | awk '{ exit !(\$1 == 0.05 && \$3 > 0.5095 * 0.98 && \$3 < 0.5095 * 1.02) }'"
+u=$(tail -n 1 "$tmp/lift-beside/postProcessing/momentum/momentum.dat" 2>/dev/null)
+check "regionLift's box beside the column: no lift, the column falls ($u)" \
+    "echo '$u' | awk '{ exit !(\$1 == 0.05 && \$3 < 0) }'"
+
 # ---- a tutorial copied anywhere runs its Allrun with mpsflow on PATH --------------
 mkdir -p "$tmp/run"
 cp -r "$prefix/share/mpsflow/tutorials/damBreak2D" "$tmp/run/myDamBreak"

@@ -23,6 +23,7 @@
 
 struct mf_emitters; /* mf_emitter.h */
 struct mf_walls;    /* mf_walls.h */
+struct mf_trimesh_reader; /* mf_trimesh.h */
 
 typedef struct mf_fluid {
     char name[64];
@@ -124,6 +125,12 @@ typedef struct mf_sim {
      * a run restarted from a snapshot then repeats the straight run bit for
      * bit, both having started afresh at that step. */
     long snapshot_epoch;
+    /* How a module reads a polygon file it names (a control force's target
+     * mesh: solvers/force/control/), found as the geometry's are: relative
+     * to mesh_relative_to (constant/geometry), then constant/triSurface/.
+     * NULL when the driver gives none (a test's sim). */
+    const struct mf_trimesh_reader *mesh_reader;
+    const char *mesh_relative_to;
     /* This step's force accelerations (mf_force_accumulate). */
     mf_force_record forces_record;
     /* Tests only: a hook the calling wrappers offer their results to (no

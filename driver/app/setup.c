@@ -224,7 +224,10 @@ int mf_app_setup(mf_app *app)
     sim->end_time = app->opt.end_time > 0 ? app->opt.end_time : c->end_time;
     MF_CALL(mf_scene_read_fluids(app->cs.fluids, sim));
     mf_dict *resolved = app->cs.resolved;
-    const mf_trimesh_reader mesh_reader = mf_mesh_import_reader(); /* polygon files */
+    static mf_trimesh_reader mesh_reader; /* polygon files, for the scene and the modules */
+    mesh_reader = mf_mesh_import_reader();
+    sim->mesh_reader = &mesh_reader;
+    sim->mesh_relative_to = app->cs.geometry->loc.file; /* constant/geometry */
     MF_CALL(mf_app_memory_budget(app, &app->budget));
     MF_CALL(mf_scene_build_budgeted(app->cs.geometry, app->opt.l0, sim,
                                     mf_dict_set_subdict(resolved, "geometry"), &mesh_reader,

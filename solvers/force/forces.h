@@ -11,5 +11,9 @@
 extern const mf_force_ops mf_force_gravity;
 extern const mf_force_ops mf_force_surfaceTension; /* surfaceTension/, Appendix A */
 extern const mf_force_ops mf_force_drag;           /* drag.c, Appendix B */
+/* control/: directing the fluid (issue 18; control/control.h) */
+extern const mf_force_ops mf_force_attraction;     /* Thuerey et al. 2006 */
+extern const mf_force_ops mf_force_velocityRegion;
+extern const mf_force_ops mf_force_pathFollow;
 
 #endif
