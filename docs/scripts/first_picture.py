@@ -5,8 +5,8 @@ colour by the magnitude of Velocities), without a window:
     build/driver/mpsflowParaView docs/scripts/first_picture.py \
         tutorials/damBreak2D/output/particles.xdmf 0.3 damBreak2D.png
 
-(mpsflowParaView runs pvbatch, under xvfb-run with a 24-bit screen and
-software OpenGL where there is no display.) argv: the XDMF index, the time
+(mpsflowParaView runs pvbatch, under an Xvfb of its own with a 24-bit
+screen and software OpenGL where there is no display.) argv: the XDMF index, the time
 to show (the nearest snapshot is used), the PNG to write. Needs ParaView
 (apt-get install paraview python3-paraview xvfb xauth libgl1-mesa-dri)."""
 import sys
