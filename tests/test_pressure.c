@@ -19,6 +19,10 @@
 /* Also the internal part, for the pattern fingerprint behind reuseSetup. */
 #define MF_PRESSURE_HYPRE_INTERNAL
 #include "pressure/pressure_hypre.h"
+#include "pressure/amg_vcycle.h"
+
+#include <HYPRE_IJ_mv.h>
+#include <omp.h>
 
 static int rank = 0, nprocs = 1;
 
@@ -478,6 +482,147 @@ static void test_named_rows(void)
     mf_pressure_PCG_BoomerAMG.destroy(fresh);
 }
 
+/* Our V-cycle (amg_vcycle.c) is hypre's in exact arithmetic: over the same
+ * hierarchy, one cycle from each on the same residual agree to rounding;
+ * and PCG around ours takes hypre's PCG's iterations (within one) to the
+ * same tolerance. One rank, one thread (hypre's hybrid Gauss-Seidel on
+ * several threads is Jacobi between the threads' blocks: another cycle). */
+static void test_own_vcycle(void)
+{
+    if (nprocs > 1)
+        return;
+    const int saved_threads = omp_get_max_threads();
+    omp_set_num_threads(1);
+    poisson p;
+    poisson_build(&p, 48);
+    /* Variable coefficients: a symmetric matrix less regular than the
+     * 5-point stencil, its diagonal the off-diagonal sums plus a little. */
+    const size_t n = p.A.nrows;
+    double *dsum = calloc(n, sizeof *dsum);
+    for (size_t r = 0; r < n; r++)
+        for (size_t k = p.A.rowptr[r]; k < p.A.rowptr[r + 1]; k++) {
+            const size_t c = (size_t)p.A.col[k];
+            if (c != r) {
+                const size_t lo = r < c ? r : c, hi = r < c ? c : r;
+                p.A.val[k] = -(1.0 + 0.5 * sin(0.37 * (double)lo + 0.11 * (double)hi));
+                dsum[r] -= p.A.val[k];
+            }
+        }
+    for (size_t r = 0; r < n; r++)
+        for (size_t k = p.A.rowptr[r]; k < p.A.rowptr[r + 1]; k++)
+            if ((size_t)p.A.col[k] == r)
+                p.A.val[k] = dsum[r] + 0.01;
+
+    /* hypre's matrix and vectors. */
+    HYPRE_IJMatrix ij = NULL;
+    HYPRE_IJVector ijr = NULL, ijz = NULL;
+    HYPRE_ParCSRMatrix parA = NULL;
+    HYPRE_ParVector parr = NULL, parz = NULL;
+    void *obj = NULL;
+    const HYPRE_BigInt up = (HYPRE_BigInt)n - 1;
+    HYPRE_Int *ncols = malloc(n * sizeof *ncols);
+    HYPRE_BigInt *rows = malloc(n * sizeof *rows), *cols = malloc(p.A.rowptr[n] * sizeof *cols);
+    double *r = malloc(n * sizeof *r), *zh = malloc(n * sizeof *zh), *zo = malloc(n * sizeof *zo);
+    for (size_t i = 0; i < n; i++) {
+        rows[i] = (HYPRE_BigInt)i;
+        ncols[i] = (HYPRE_Int)(p.A.rowptr[i + 1] - p.A.rowptr[i]);
+        r[i] = cos(0.3 * (double)i) + 0.2 * (double)(i % 7);
+        zh[i] = 0.0;
+    }
+    for (size_t k = 0; k < p.A.rowptr[n]; k++)
+        cols[k] = (HYPRE_BigInt)p.A.col[k];
+    CHECK(HYPRE_IJMatrixCreate(MPI_COMM_WORLD, 0, up, 0, up, &ij) == 0);
+    HYPRE_IJMatrixSetObjectType(ij, HYPRE_PARCSR);
+    HYPRE_IJMatrixInitialize(ij);
+    HYPRE_IJMatrixSetValues(ij, (HYPRE_Int)n, ncols, rows, cols, p.A.val);
+    CHECK(HYPRE_IJMatrixAssemble(ij) == 0);
+    HYPRE_IJMatrixGetObject(ij, &obj);
+    parA = obj;
+    HYPRE_IJVector *vecs[2] = {&ijr, &ijz};
+    HYPRE_ParVector *pars[2] = {&parr, &parz};
+    for (int v = 0; v < 2; v++) {
+        HYPRE_IJVectorCreate(MPI_COMM_WORLD, 0, up, vecs[v]);
+        HYPRE_IJVectorSetObjectType(*vecs[v], HYPRE_PARCSR);
+        HYPRE_IJVectorInitialize(*vecs[v]);
+        HYPRE_IJVectorSetValues(*vecs[v], (HYPRE_Int)n, rows, v == 0 ? r : zh);
+        HYPRE_IJVectorAssemble(*vecs[v]);
+        HYPRE_IJVectorGetObject(*vecs[v], &obj);
+        *pars[v] = obj;
+    }
+
+    mf_pcg_boomeramg_settings s;
+    defaults(&mf_pressure_PCG_BoomerAMG, &s);
+    HYPRE_Solver amg = NULL;
+    CHECK_OK(mf_boomeramg_create(&s, &amg));
+    CHECK(HYPRE_BoomerAMGSetup(amg, parA, parr, parz) == 0);
+    /* hypre's cycle: z = M r from z = 0; then ours takes the hierarchy. */
+    CHECK(HYPRE_BoomerAMGSolve(amg, parA, parr, parz) == 0);
+    HYPRE_IJVectorGetValues(ijz, (HYPRE_Int)n, rows, zh);
+    mf_amg_vcycle *cycle = NULL;
+    CHECK_OK(mf_amg_vcycle_take(amg, &cycle));
+    CHECK_MSG(cycle != NULL, "the default settings' hierarchy is not one our cycle runs");
+    if (cycle != NULL) {
+        mf_split_csr fine = {0};
+        CHECK_OK(mf_split_csr_set(&fine, &p.A));
+        mf_amg_vcycle_apply(cycle, &fine, NULL, r, zo);
+        double dmax = 0.0, zmax = 0.0;
+        for (size_t i = 0; i < n; i++) {
+            dmax = fmax(dmax, fabs(zo[i] - zh[i]));
+            zmax = fmax(zmax, fabs(zh[i]));
+        }
+        printf("own V-cycle against hypre's: max |difference| %.3g of max |z| %.3g\n", dmax,
+               zmax);
+        CHECK_MSG(zmax > 0.0 && dmax <= 1e-12 * zmax, "V-cycles differ by %g (max |z| %g)",
+                  dmax, zmax);
+        mf_split_csr_free(&fine);
+    }
+    mf_amg_vcycle_free(cycle);
+    HYPRE_BoomerAMGDestroy(amg);
+
+    /* PCG: the module's (our PCG and cycle, the default relaxType 3) against
+     * hypre's PCG around hypre's cycle, same settings, same tolerance. */
+    make_rhs(&p);
+    memset(p.x, 0, n * sizeof *p.x);
+    mf_solve_report rep;
+    CHECK_OK(solve_once(&mf_pressure_PCG_BoomerAMG, &s, &p, &rep));
+    CHECK(rep.converged && rep.final_residual <= 1e-8);
+    HYPRE_Solver pcg = NULL;
+    CHECK_OK(mf_boomeramg_create(&s, &amg));
+    HYPRE_ParCSRPCGCreate(MPI_COMM_WORLD, &pcg);
+    HYPRE_PCGSetTol(pcg, 1e-8);
+    HYPRE_PCGSetMaxIter(pcg, 500);
+    HYPRE_PCGSetTwoNorm(pcg, 1);
+    HYPRE_PCGSetRecomputeResidual(pcg, 1);
+    HYPRE_ParCSRPCGSetPrecond(pcg, HYPRE_BoomerAMGSolve, HYPRE_BoomerAMGSetup, amg);
+    HYPRE_IJVectorSetValues(ijr, (HYPRE_Int)n, rows, p.b);
+    memset(zh, 0, n * sizeof *zh);
+    HYPRE_IJVectorSetValues(ijz, (HYPRE_Int)n, rows, zh);
+    HYPRE_ParCSRPCGSetup(pcg, parA, parr, parz);
+    CHECK(HYPRE_ParCSRPCGSolve(pcg, parA, parr, parz) == 0);
+    HYPRE_Int its = 0;
+    HYPRE_ParCSRPCGGetNumIterations(pcg, &its);
+    printf("PCG iterations: %d with our V-cycle, %d with hypre's; error %.3g\n",
+           rep.iterations, (int)its, rel_error(&p));
+    CHECK_MSG(abs(rep.iterations - (int)its) <= 1, "%d iterations against hypre's %d",
+              rep.iterations, (int)its);
+    CHECK(rel_error(&p) <= kappa_poisson(48) * 100 * rep.final_residual);
+    HYPRE_ParCSRPCGDestroy(pcg);
+    HYPRE_BoomerAMGDestroy(amg);
+
+    HYPRE_IJMatrixDestroy(ij);
+    HYPRE_IJVectorDestroy(ijr);
+    HYPRE_IJVectorDestroy(ijz);
+    free(ncols);
+    free(rows);
+    free(cols);
+    free(r);
+    free(zh);
+    free(zo);
+    free(dsum);
+    poisson_free(&p);
+    omp_set_num_threads(saved_threads);
+}
+
 /* The fingerprint that decides reuse: blind to values, not to the pattern. */
 static void test_pattern_hash(void)
 {
@@ -581,6 +726,7 @@ int main(int argc, char **argv)
     test_warm_start(&mf_pressure_PCG_diagonal, &ds);
     test_reuse();
     test_named_rows();
+    test_own_vcycle();
     test_pattern_hash();
     test_bad_input();
 

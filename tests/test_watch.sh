@@ -71,9 +71,14 @@ PY
 trip "fluid pushed apart" densityCollapse -endTime 0.2
 
 # The paper's scheme without stabilisation blows up on this case (README):
-# the energy criterion sees it first.
+# the energy criterion sees it first. When it blows up depends on the
+# rounding of the pressure solves (t = 0.29 to 0.49 s with one solver or
+# another, a tolerance of 1e-8 or 1e-9), and so does what a retry of the
+# step meets: a particle may then pass the floor within the retried step
+# (throughWall, checked before energy). No retry: the first failure ends
+# the run.
 fresh; sed -i 's/    relaxation      0.2;//; s/    collision       yes;//' "$dir/case/system/solverDict"
-sed -i 's/^maxRetries.*//' "$dir/case/system/controlDict"; printf 'maxRetries 1;\n' >> "$dir/case/system/controlDict"
+sed -i 's/^maxRetries.*//' "$dir/case/system/controlDict"; printf 'maxRetries 0;\n' >> "$dir/case/system/controlDict"
 trip "plain scheme blowing up" energy
 
 # A pressure solve held to one PCG iteration at a tolerance it cannot reach.

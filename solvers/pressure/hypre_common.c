@@ -18,8 +18,10 @@
 
 #include <mpi.h>
 
+#include "amg_vcycle.h"
 #include "mf_error.h"
 #include "mf_hash.h"
+#include "row_dot.h"
 
 /* Largest values hypre's index types hold in this build (Debian's 2.26:
  * both 32-bit). */
@@ -222,6 +224,25 @@ static int residual_norm(const char *who, const mf_csr *A, const double *b, cons
     return 0;
 }
 
+/* One rank: r = b - A x from the caller's CSR; returns ||r||. */
+typedef struct local_system {
+    const mf_csr *A;
+    const double *b;
+} local_system;
+
+static double residual_local(const void *ctx, const double *x, double *r)
+{
+    const local_system *sys = ctx;
+    const mf_csr *A = sys->A;
+    double sum = 0.0;
+    for (size_t i = 0; i < A->nrows; i++) {
+        const size_t k = A->rowptr[i];
+        r[i] = sys->b[i] - mf_row_dot(A->col + k, A->val + k, A->rowptr[i + 1] - k, x);
+        sum += r[i] * r[i];
+    }
+    return sqrt(sum);
+}
+
 /* ---- assembly ------------------------------------------------------------ */
 
 typedef struct hypre_system {
@@ -396,6 +417,40 @@ out:
     return rc;
 }
 
+/* ---- a hierarchy for our own V-cycle (one rank) -------------------------- */
+
+int mf_hypre_setup_cycle(const char *who, HYPRE_Solver amg, const mf_csr *A,
+                         const mf_row_names *rows, mf_amg_vcycle **cycle)
+{
+    hypre_system sys = {0};
+    int rc = 0;
+    *cycle = NULL;
+    /* The set-up reads the matrix only: zero vectors will do. */
+    double *zero = calloc(A->nrows + 1, sizeof *zero);
+    if (zero == NULL) {
+        HYPRE_BoomerAMGDestroy(amg);
+        return MF_ERROR(MF_ERR_MEMORY, "%s: out of memory (%zu rows)", who, A->nrows);
+    }
+    rc = assemble(who, A, rows, zero, zero, &sys);
+    if (rc == 0) {
+        HYPRE_Int ierr = HYPRE_BoomerAMGSetup(amg, sys.parA, sys.parb, sys.parx);
+        if (ierr != 0)
+            rc = mf_hypre_error(who, "HYPRE_BoomerAMGSetup", ierr, __FILE__, __LINE__, __func__);
+    }
+    /* The copy reads the coarse levels only: the fine matrix goes first, and
+     * the copy frees hypre's levels as it goes (peak memory: one hierarchy
+     * and a bit, not two and the matrix). amg then only needs destroying
+     * (it never frees the finest level, the caller's). */
+    system_free(&sys);
+    if (rc == 0)
+        rc = mf_amg_vcycle_take(amg, cycle);
+    HYPRE_BoomerAMGDestroy(amg);
+    free(zero);
+    if (rc != 0)
+        return mf_error_trace(rc, __FILE__, __LINE__, __func__);
+    return 0;
+}
+
 /* ---- pattern fingerprint (for reusing an AMG hierarchy) ------------------ */
 
 int mf_hypre_pattern_hash(const mf_csr *A, uint64_t *hash)
@@ -430,6 +485,7 @@ int mf_hypre_pcg_solve(const mf_hypre_pcg *pcg, const mf_csr *A, const double *b
     mf_hypre_precond pc = {0};
     HYPRE_Solver solver = NULL;
     bool prepared = false, converged = false;
+    double *r = NULL;
     int rc = 0;
 
     if (rep == NULL)
@@ -456,8 +512,21 @@ int mf_hypre_pcg_solve(const mf_hypre_pcg *pcg, const mf_csr *A, const double *b
         rep->setup_seconds = MPI_Wtime() - t_start;
         goto done;
     }
+    /* One rank with a module that runs its own V-cycle: the residual vector
+     * is PCG's start. */
+    const bool own = lay.nprocs == 1 && pcg->cycle_prepare != NULL;
+    const local_system loc = {A, b};
     double rnorm = 0.0;
-    MF_CALL_GOTO(rc, residual_norm(who, A, b, x, &lay, &rnorm), done);
+    if (own) {
+        r = malloc((A->nrows + 1) * sizeof *r);
+        if (r == NULL) {
+            rc = MF_ERROR(MF_ERR_MEMORY, "%s: out of memory for the residual (%zu rows)", who,
+                          A->nrows);
+            goto done;
+        }
+        rnorm = residual_local(&loc, x, r);
+    } else
+        MF_CALL_GOTO(rc, residual_norm(who, A, b, x, &lay, &rnorm), done);
     rep->initial_residual = rnorm / bnorm;
     if (!isfinite(rep->initial_residual)) {
         rc = MF_ERROR(MF_ERR_NUMERIC,
@@ -485,6 +554,28 @@ int mf_hypre_pcg_solve(const mf_hypre_pcg *pcg, const mf_csr *A, const double *b
         rc = MF_ERROR(MF_ERR_INPUT, "%s: %" PRId64 " slots for %zu rows", who, rows->nslots,
                       A->nrows);
         goto done;
+    }
+    if (own) {
+        mf_amg_vcycle *cycle = NULL;
+        MF_CALL_GOTO(rc, pcg->cycle_prepare(pcg->ctx, A, rows, &cycle), done);
+        if (cycle != NULL) {
+            prepared = true;
+            const double t_solve = MPI_Wtime();
+            rep->setup_seconds = t_solve - t_start;
+            rc = mf_amg_pcg(cycle, A, rows ? rows->slot : NULL, x, r, bnorm, pcg->tolerance,
+                            pcg->max_iter, residual_local, &loc, &rep->iterations,
+                            &rep->final_residual);
+            if (rc != 0 && rc != MF_RETRY) {
+                mf_error_trace(rc, __FILE__, __LINE__, __func__);
+                goto done;
+            }
+            rc = 0; /* not converged: said below, with the figures */
+            converged = rep->final_residual <= pcg->tolerance; /* false for NaN */
+            rep->converged = converged;
+            rep->solve_seconds = MPI_Wtime() - t_solve;
+            goto done;
+        }
+        /* Not a hierarchy our cycle runs: hypre's PCG. */
     }
     MF_CALL_GOTO(rc, assemble(who, A, rows, b, x, &sys), done);
     rc = pcg->precond_prepare(pcg->ctx, A, rows, &pc);
@@ -537,6 +628,7 @@ done:
         pcg->precond_release(pcg->ctx, rep, rc == 0 && converged);
     system_free(&sys);
     layout_free(&lay);
+    free(r);
     if (rc == 0 && !converged)
         rc = MF_ERROR(MF_RETRY,
                       "%s: not converged after %d iterations (final residual %g > tolerance %g)",

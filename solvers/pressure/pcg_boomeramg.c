@@ -44,13 +44,17 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "amg_vcycle.h"
 #include "mf_error.h"
 
 static const char module_name[] = "PCG_BoomerAMG";
 
 typedef struct pcg_boomeramg {
     mf_pcg_boomeramg_settings s;
-    HYPRE_Solver amg;  /* between solves only when it may serve again */
+    /* The hierarchy, between solves only when it may serve again: hypre's
+     * (amg), or on one rank the copy our V-cycle runs (cycle). */
+    HYPRE_Solver amg;
+    mf_amg_vcycle *cycle;
     bool reused;       /* the current solve reuses amg */
     /* reuseSetup: the pattern amg was set up with, the solves it may serve. */
     uint64_t pattern;
@@ -159,11 +163,13 @@ static void discard_hierarchy(pcg_boomeramg *d)
     if (d->amg)
         HYPRE_BoomerAMGDestroy(d->amg);
     d->amg = NULL;
+    mf_amg_vcycle_free(d->cycle);
+    d->cycle = NULL;
     d->reuses_left = 0;
     d->slot_space = false;
 }
 
-static int create_amg(const mf_pcg_boomeramg_settings *s, HYPRE_Solver *out)
+int mf_boomeramg_create(const mf_pcg_boomeramg_settings *s, HYPRE_Solver *out)
 {
     HYPRE_Solver amg = NULL;
     int rc = 0;
@@ -217,7 +223,8 @@ static HYPRE_Int keep_hierarchy(HYPRE_Solver amg, HYPRE_ParCSRMatrix A, HYPRE_Pa
  * space (same slots, same epoch, its iterations not grown too far). */
 static bool may_keep(const pcg_boomeramg *d, const mf_row_names *rows)
 {
-    if (!d->amg || !d->slot_space || rows->nslots != d->nslots || rows->epoch != d->epoch)
+    if (!(d->amg || d->cycle) || !d->slot_space || rows->nslots != d->nslots ||
+        rows->epoch != d->epoch)
         return false;
     const int first = d->first_iterations;
     if (first < 0)
@@ -230,6 +237,8 @@ static int precond_prepare(void *ctx, const mf_csr *A, const mf_row_names *rows,
 {
     pcg_boomeramg *d = ctx;
     d->reused = false;
+    if (d->cycle) /* kept for our V-cycle: of no use to hypre's */
+        discard_hierarchy(d);
     if (rows && d->s.reuse_hierarchy) {
         if (may_keep(d, rows)) {
             d->reused = true;
@@ -237,7 +246,7 @@ static int precond_prepare(void *ctx, const mf_csr *A, const mf_row_names *rows,
             return 0;
         }
         discard_hierarchy(d);
-        MF_CALL(create_amg(&d->s, &d->amg));
+        MF_CALL(mf_boomeramg_create(&d->s, &d->amg));
         d->slot_space = true;
         d->nslots = rows->nslots;
         d->epoch = rows->epoch;
@@ -259,9 +268,58 @@ static int precond_prepare(void *ctx, const mf_csr *A, const mf_row_names *rows,
         discard_hierarchy(d);
         d->pattern = pattern;
     }
-    MF_CALL(create_amg(&d->s, &d->amg));
+    MF_CALL(mf_boomeramg_create(&d->s, &d->amg));
     d->reuses_left = d->s.reuse_setup;
     *pc = (mf_hypre_precond){HYPRE_BoomerAMGSolve, HYPRE_BoomerAMGSetup, d->amg};
+    return 0;
+}
+
+/* One rank: our V-cycle over the hierarchy hypre sets up, kept under the
+ * same rules as precond_prepare's (amg_vcycle.h says why). *cycle NULL: the
+ * smoother is not relaxType 3, or hypre's hierarchy is not one the cycle
+ * runs (a single level, a large coarsest level): hypre's PCG then runs. */
+static int cycle_prepare(void *ctx, const mf_csr *A, const mf_row_names *rows,
+                         mf_amg_vcycle **cycle)
+{
+    pcg_boomeramg *d = ctx;
+    *cycle = NULL;
+    d->reused = false;
+    if (d->s.relax_type != 3 || d->amg != NULL) /* hypre's own, or a hierarchy of hypre's kept */
+        return 0;
+    if (rows && d->s.reuse_hierarchy) {
+        if (d->cycle && may_keep(d, rows)) {
+            d->reused = true;
+            *cycle = d->cycle;
+            return 0;
+        }
+    }
+    uint64_t pattern = 0;
+    const bool by_pattern = !(rows && d->s.reuse_hierarchy) && d->s.reuse_setup > 0;
+    if (by_pattern) {
+        MF_CALL(mf_hypre_pattern_hash(A, &pattern));
+        if (d->cycle && !d->slot_space && d->reuses_left > 0 && pattern == d->pattern) {
+            d->reuses_left--;
+            d->reused = true;
+            *cycle = d->cycle;
+            return 0;
+        }
+    }
+    discard_hierarchy(d);
+    d->pattern = pattern;
+    HYPRE_Solver amg = NULL;
+    MF_CALL(mf_boomeramg_create(&d->s, &amg));
+    const mf_row_names *slots = rows && d->s.reuse_hierarchy ? rows : NULL;
+    MF_CALL(mf_hypre_setup_cycle(module_name, amg, A, slots, &d->cycle));
+    if (d->cycle == NULL)
+        return 0;
+    d->slot_space = slots != NULL;
+    if (slots) {
+        d->nslots = rows->nslots;
+        d->epoch = rows->epoch;
+        d->first_iterations = -1;
+    } else
+        d->reuses_left = d->s.reuse_setup;
+    *cycle = d->cycle;
     return 0;
 }
 
@@ -292,6 +350,7 @@ static int solve_impl(pcg_boomeramg *d, const mf_csr *A, const mf_row_names *row
         .max_iter = d->s.max_iter,
         .rows = d->s.reuse_hierarchy ? rows : NULL,
         .precond_prepare = precond_prepare,
+        .cycle_prepare = cycle_prepare,
         .precond_release = precond_release,
         .ctx = d,
     };
@@ -299,7 +358,7 @@ static int solve_impl(pcg_boomeramg *d, const mf_csr *A, const mf_row_names *row
     if (rep == NULL)
         rep = &local;
     d->reused = false;
-    if (d->amg == NULL || A == NULL || x == NULL) {
+    if ((d->amg == NULL && d->cycle == NULL) || A == NULL || x == NULL) {
         MF_CALL(mf_hypre_pcg_solve(&pcg, A, b, x, rep));
         return 0;
     }

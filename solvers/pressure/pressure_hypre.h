@@ -59,6 +59,9 @@ extern const mf_pressure_ops mf_pressure_PCG_diagonal;
 #include <HYPRE_krylov.h>
 #include <HYPRE_parcsr_ls.h>
 
+/* Our V-cycle over a hierarchy of hypre's (amg_vcycle.h). */
+typedef struct mf_amg_vcycle mf_amg_vcycle;
+
 /* The preconditioner PCG uses: hypre's (solve, setup, data) triple. */
 typedef struct mf_hypre_precond {
     HYPRE_PtrToParSolverFcn solve;
@@ -82,7 +85,14 @@ typedef struct mf_hypre_pcg {
      * not at all for b = 0 or an initial guess that already converged).
      * rows: the slots the system is assembled in (NULL: row space). */
     int (*precond_prepare)(void *ctx, const mf_csr *A, const mf_row_names *rows, mf_hypre_precond *pc);
-    /* Called after every prepare that succeeded, whatever happened next;
+    /* Optional, one rank: the module's own V-cycle for this solve
+     * (amg_vcycle.h), which then runs in our PCG; *cycle NULL: hypre's PCG
+     * with precond_prepare. Called after the cheap exits; may set a
+     * hierarchy up with mf_hypre_setup_cycle. */
+    int (*cycle_prepare)(void *ctx, const mf_csr *A, const mf_row_names *rows,
+                         mf_amg_vcycle **cycle);
+    /* Called after every prepare that succeeded (precond_prepare, or a
+     * cycle_prepare that gave a cycle), whatever happened next;
      * converged tells whether this solve reached the tolerance, rep how. */
     void (*precond_release)(void *ctx, const mf_solve_report *rep, bool converged);
     void *ctx;
@@ -92,6 +102,16 @@ typedef struct mf_hypre_pcg {
  * MF_RETRY when not converged (report filled), or a negative error. */
 int mf_hypre_pcg_solve(const mf_hypre_pcg *pcg, const mf_csr *A, const double *b, double *x,
                        mf_solve_report *rep);
+
+/* A BoomerAMG solver with PCG_BoomerAMG's settings s, as one V-cycle a
+ * call (a preconditioner), not yet set up. */
+int mf_boomeramg_create(const mf_pcg_boomeramg_settings *s, HYPRE_Solver *out);
+
+/* One rank: assemble A as hypre's (in slot space when rows), set the AMG
+ * solver amg up on it, take the hierarchy for our V-cycle (*cycle; NULL when
+ * it is not one the cycle runs), and destroy hypre's matrix and amg. */
+int mf_hypre_setup_cycle(const char *who, HYPRE_Solver amg, const mf_csr *A,
+                         const mf_row_names *rows, mf_amg_vcycle **cycle);
 
 /* A 64-bit fingerprint of the sizes, row range and sparsity pattern of this
  * rank's rows, agreed over all ranks (the same value everywhere). */

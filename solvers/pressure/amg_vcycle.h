@@ -1,0 +1,97 @@
+/* amg_vcycle.h: a V-cycle of our own over a hierarchy that hypre's BoomerAMG
+ * set up, and the PCG around it, for a solve on one MPI rank.
+ *
+ * Why: on one rank the solve phase of hypre's PCG + BoomerAMG spends its time
+ * in loops that add one product at a time into one sum (the matrix-vector
+ * product, the Gauss-Seidel sweeps), so every non-zero waits for the addition
+ * before it; it visits the fine matrix four times an iteration (the PCG
+ * product, the sweep down, the residual, the sweep up) and applies the
+ * preconditioner once more after the last iteration. Here the set-up stays
+ * hypre's (coarsening, interpolation, the Galerkin products, everything that
+ * makes AMG work) and the cycle is the same operator in exact arithmetic:
+ *
+ *  - the smoother of relaxType 3 on one rank: Gauss-Seidel, forward on the
+ *    way down (from a zero guess, as a V-cycle correction starts), backward
+ *    on the way up; Gaussian elimination (LAPACK's LU) on the coarsest level;
+ *  - a forward sweep from zero leaves (D + L) u = f, so its residual is
+ *    f - A u = -U u: the sweep reads the entries left of the diagonal, the
+ *    residual those right of it, one pass over the matrix for both (Briggs,
+ *    Henson and McCormick, "A Multigrid Tutorial", 2nd ed., SIAM 2000, on
+ *    the residual after a Gauss-Seidel sweep);
+ *  - the rows' sums use four partial sums, so the additions overlap.
+ *
+ * The fine level is the caller's matrix of this solve (rows in row space,
+ * each mapped to its row of the first interpolation by its slot), copied
+ * into the split layout for the solve and freed after it; the coarse levels and interpolations
+ * are copies of hypre's, taken right after the set-up, hypre's freed as
+ * they are copied.
+ */
+#ifndef MF_AMG_VCYCLE_H
+#define MF_AMG_VCYCLE_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "mf_modules.h"
+
+/* A square matrix by rows, the diagonal apart: the off-diagonal entries of
+ * row i are [ptr[i], ptr[i + 1]), those of columns below i first
+ * ([ptr[i], mid[i])), then those above. */
+typedef struct mf_split_csr {
+    int32_t n;
+    int32_t *ptr, *mid, *col;
+    double *val;
+    double *diag, *dinv; /* dinv[i] = 1 / diag[i] (0 for a zero diagonal) */
+    size_t cap_rows, cap_nnz;
+} mf_split_csr;
+
+/* Copy a CSR of one rank (columns in [0, n), any order, the diagonal
+ * anywhere in its row, duplicates summed into it) into the split layout,
+ * growing s's arrays as needed. */
+int mf_split_csr_set(mf_split_csr *s, const mf_csr *A);
+void mf_split_csr_free(mf_split_csr *s);
+
+/* q = A p; returns p . q. */
+double mf_split_csr_matvec_dot(const mf_split_csr *A, const double *p, double *q);
+
+typedef struct mf_amg_vcycle mf_amg_vcycle;
+
+#ifdef MF_PRESSURE_HYPRE_INTERNAL
+/* Take the hierarchy of an AMG solver hypre has set up (one rank, at least
+ * two levels, a coarsest level of at most MF_AMG_MAX_COARSEST rows): copy
+ * it, freeing hypre's coarse levels and interpolations as they are copied,
+ * so that amg is then good for HYPRE_BoomerAMGDestroy only (the finest
+ * level, the caller's matrix, is not read: it may be freed already).
+ * Returns 0 with *out, or 0 with *out NULL when the hierarchy is not one
+ * this cycle runs (the caller then uses hypre's cycle, set up again);
+ * negative on a failure. The hierarchy's first interpolation has one row
+ * per unknown of the set-up's matrix (a slot). */
+int mf_amg_vcycle_take(HYPRE_Solver amg, mf_amg_vcycle **out);
+#endif
+#define MF_AMG_MAX_COARSEST 2000
+
+void mf_amg_vcycle_free(mf_amg_vcycle *v);
+
+/* z = M r, one V-cycle with the fine matrix A0, whose row i is row
+ * prow[i] of the first interpolation (NULL: row i). */
+void mf_amg_vcycle_apply(mf_amg_vcycle *v, const mf_split_csr *A0, const int64_t *prow,
+                         const double *r, double *z);
+
+/* PCG on one rank preconditioned by the V-cycle, for the matrix A of this
+ * solve (one rank's CSR: columns in [0, nrows)), whose row i is row prow[i]
+ * of the first interpolation (NULL: row i; prow's values distinct, inside
+ * [0, the first interpolation's rows)). x holds the initial guess and
+ * returns the solution, r holds r0 = b - A x0 on entry (the caller has it from the
+ * initial residual) and is overwritten. The recursion's residual says when
+ * to look; the true one, resid(ctx, x, r) = ||b - A x|| (also writing r,
+ * from the caller's matrix), decides: 0 when it is at most tol ||b||,
+ * MF_RETRY (no message) when max_iter passed or the recursion broke down
+ * (A or the cycle not positive definite). *iterations and *rel = the true
+ * ||b - A x|| / ||b|| in both cases. */
+typedef double (*mf_residual_fn)(const void *ctx, const double *x, double *r);
+int mf_amg_pcg(mf_amg_vcycle *v, const mf_csr *A, const int64_t *prow, double *x, double *r,
+               double bnorm, double tol, long max_iter, mf_residual_fn resid, const void *ctx,
+               int *iterations, double *rel);
+
+#endif
