@@ -53,7 +53,7 @@ int main(int argc, char **argv)
     const int rows = p->dim == 3 ? 9 : 3;
     const double per_cell = (double)g.ncells * (sizeof(uint64_t) + sizeof(size_t) +
                                                 rows * 2 * sizeof(uint32_t)) +
-                            (double)g.hash_cap * (sizeof(uint64_t) + sizeof(uint32_t));
+                            (double)mf_hashmap_memory(&g.cells);
     const double per_particle = total - per_cell;
     /* A dense grid of the bounding box: one offset per box cell at least. */
     const double dense = box * sizeof(size_t) + per_particle;

@@ -68,6 +68,9 @@ median() {
 
 if [ "${CALLGRIND:-0}" = 1 ]; then
     command -v valgrind > /dev/null || { echo "valgrind is missing (apt-get install valgrind)"; exit 1; }
+    # mpsflow re-executes itself to set OpenMP's wait policy when none is
+    # set, and valgrind does not follow the exec: set it here.
+    export OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-passive}
     for bin in "$A" "$B"; do
         valgrind --tool=callgrind --callgrind-out-file="$WORK/cg" "$bin" -case "$WORK/2d" \
             -l0 0.005 -endTime 0.02 -quiet -overwrite > /dev/null 2>&1

@@ -435,7 +435,7 @@ EXPECTED.update({
     'unknown top-level key':
         "--> mpsflow FATAL ERROR: {case}/system/solverDict:39:1: unknown key 'MSPCoeffs' in '(top level)' (did you mean 'MPSCoeffs'?); valid keys: solver, pressure, viscosity, forces, FoamFile, MPSCoeffs, multiFluidCoeffs, MAFLCoeffs",
     'unknown coefficient':
-        "--> mpsflow FATAL ERROR: {case}/system/solverDict:21:5: unknown key 'bta' in 'MPSCoeffs' (did you mean 'beta'?); valid keys: reNumberDensity, reGradient, reLaplacian, beta, relaxation, compressibility, clipNegativePressure, gradientPmin, collision, collisionAfterCorrection, collisionDistance, restitution, reorderInterval, viscosity, periodicLength, periodicOrigin",
+        "--> mpsflow FATAL ERROR: {case}/system/solverDict:21:5: unknown key 'bta' in 'MPSCoeffs' (did you mean 'beta'?); valid keys: reNumberDensity, reGradient, reLaplacian, beta, relaxation, compressibility, clipNegativePressure, gradientPmin, scheme, source, densityFactor, gradient, laplacian, shifting, shiftCoefficient, shiftMax, surfaceDetection, asymmetry, retrySource, collision, collisionAfterCorrection, collisionDistance, restitution, reorderInterval, viscosity, periodicLength, periodicOrigin",
     'beta out of range':
         "--> mpsflow FATAL ERROR: {case}/system/solverDict:21:5: key 'beta': 2 is out of range [0.5, 1] (free surface where n* < beta n0 (eq. 18))",
     'reLaplacian out of range':
@@ -513,7 +513,7 @@ EXPECTED.update({
     'validate without metric':
         "--> mpsflow FATAL ERROR: cannot open dictionary file '{case}/validation/metric' (No such file or directory)",
     'unknown metric':
-        "--> mpsflow FATAL ERROR: {case}/validation/metric: unknown metric 'surge'; known: surgeFront, hydrostaticPressure, scalarAdvection, volumeFlux, laplacePressure, oscillationPeriod, layering, rayleighTaylor, fluidSurgeFront, poiseuille",
+        "--> mpsflow FATAL ERROR: {case}/validation/metric: unknown metric 'surge'; known: surgeFront, hydrostaticPressure, scalarAdvection, volumeFlux, laplacePressure, oscillationPeriod, layering, rayleighTaylor, fluidSurgeFront, poiseuille, restingTank",
     'restart without snapshots':
         '--> mpsflow FATAL ERROR: no snapshot to restart from in {case}/output (run without -latestTime first)',
     'compareDict unknown key':

@@ -16,6 +16,7 @@
 #include <string.h>
 
 #include "case_util.h"
+#include "mf_alloc.h"
 #include "mf_dictio.h"
 #include "mf_pairs.h"
 #include "mf_test.h"
@@ -32,9 +33,7 @@ static void series_add(series *s, double x, double y)
 {
     if (s->n == s->cap) {
         s->cap = s->cap ? 2 * s->cap : 64;
-        s->x = realloc(s->x, s->cap * sizeof *s->x);
-        s->y = realloc(s->y, s->cap * sizeof *s->y);
-        if (!s->x || !s->y)
+        if (mf_resize(&s->x, s->cap, sizeof *s->x) || mf_resize(&s->y, s->cap, sizeof *s->y))
             abort();
     }
     s->x[s->n] = x;

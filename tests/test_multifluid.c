@@ -37,7 +37,8 @@ static const char *const dam_geometry =
     "dimension 2;\nparticleSpacing 0.02;\n"
     "fluidBlocks { column { type box; min (0 0 0); max (0.25 0.5 0); fluid water; } }\n"
     "walls { tank { type box; min (0 0 0); max (1.0 0.6 0); open (ymax); } }\n";
-static const char *const coeffs = "{ relaxation 0.2; collision yes; }\n";
+/* The scheme named: MPS and multiFluid have different default schemes. */
+static const char *const coeffs = "{ scheme robust; relaxation 0.2; collision yes; }\n";
 static const char *const pressure = "pressure { solver PCG_BoomerAMG; tolerance 1e-8; }\n"
                                     "forces { gravity { g (0 -9.81 0); } }\n";
 

@@ -18,6 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_alloc.h"
 #include "mf_kernel.h"
 #include "mf_neighbours.h"
 #include "mf_operators.h"
@@ -103,8 +104,8 @@ static brute brute_pairs(const mf_particles *p, double radius, double cell)
         for (size_t j = 0; j < p->n; j++) {
             if (j == i || !(dist2(p, i, j) < radius * radius))
                 continue;
-            if (used == cap)
-                b.j = realloc(b.j, (cap *= 2) * sizeof *b.j);
+            if (used == cap && mf_resize(&b.j, cap *= 2, sizeof *b.j))
+                abort();
             b.j[used++] = (uint32_t)j;
         }
         b.start[i + 1] = used;

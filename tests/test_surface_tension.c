@@ -9,7 +9,8 @@
  * one inside a square of the other: both sides together); the mean
  * curvature of the interface particles is printed. A flat free surface gets
  * no force, and the paper's curvature (eqs. 38-39) measures about 2/3 of
- * 1/R, as the sector geometry predicts (file comment of surface_tension.c).
+ * 1/R, as the sector geometry predicts (the file comment of
+ * solvers/force/surfaceTension/surface_tension.h).
  *
  * With freeSurface pressure the module gives the solver the Laplace pressure
  * of the free-surface particles instead (within 10% of sigma/R) and no force.

@@ -11,6 +11,7 @@
  */
 #ifndef MF_ERROR_H
 #define MF_ERROR_H
+#pragma GCC visibility push(default) /* the plugin API (an installed header) */
 
 #include <stdarg.h>
 #include <stdio.h>
@@ -58,4 +59,5 @@ const char *mf_status_name(int code);
         }                                                                    \
     } while (0)
 
+#pragma GCC visibility pop
 #endif

@@ -4,6 +4,7 @@
  * is replaced by one progress line with an ETA. */
 #ifndef MF_LOG_H
 #define MF_LOG_H
+#pragma GCC visibility push(default) /* the plugin API (an installed header) */
 
 #include <stdbool.h>
 #include <stdio.h>
@@ -27,4 +28,5 @@ void mf_log_printf(mf_log *log, int level, const char *fmt, ...)
 void mf_log_progress(mf_log *log, double time, double end_time, double elapsed);
 void mf_log_progress_end(mf_log *log);
 
+#pragma GCC visibility pop
 #endif

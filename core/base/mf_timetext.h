@@ -7,6 +7,7 @@
  * that names a time (the XDMF indexes, listTimes, the log) uses this. */
 #ifndef MF_TIMETEXT_H
 #define MF_TIMETEXT_H
+#pragma GCC visibility push(default) /* the plugin API (an installed header) */
 
 #include <stddef.h>
 
@@ -21,4 +22,5 @@ const char *mf_time_text(double t, char *buf, size_t len);
 /* t rounded the same way, as a number. */
 double mf_time_round(double t);
 
+#pragma GCC visibility pop
 #endif

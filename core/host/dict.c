@@ -14,6 +14,7 @@
 #include <string.h>
 #include <strings.h>
 
+#include "mf_alloc.h"
 #include "mf_error.h"
 
 /* ------------------------------------------------------------------------
@@ -59,10 +60,8 @@ static const char *pool_intern(struct mf_strpool *p, const char *s)
             return p->strings[k];
     if (p->n == p->cap) {
         size_t cap = p->cap ? 2 * p->cap : 8;
-        char **grown = realloc(p->strings, cap * sizeof *grown);
-        if (!grown)
+        if (mf_resize(&p->strings, cap, sizeof *p->strings))
             return NULL;
-        p->strings = grown;
         p->cap = cap;
     }
     char *copy = strdup(s);
@@ -166,10 +165,8 @@ mf_entry *mf_dict_append(mf_dict *d, const char *key, mf_loc loc, size_t n, mf_v
         goto fail;
     if (d->n == d->cap) {
         size_t cap = d->cap ? 2 * d->cap : 8;
-        mf_entry **grown = realloc(d->entries, cap * sizeof *grown);
-        if (!grown)
+        if (mf_resize(&d->entries, cap, sizeof *d->entries))
             goto fail;
-        d->entries = grown;
         d->cap = cap;
     }
     mf_entry *e = calloc(1, sizeof *e);

@@ -10,6 +10,7 @@
  */
 #ifndef MF_DICT_H
 #define MF_DICT_H
+#pragma GCC visibility push(default) /* the plugin API (an installed header) */
 
 #include <stdbool.h>
 #include <stddef.h>
@@ -116,4 +117,5 @@ int mf_dict_write(const mf_dict *d, FILE *f, int indent);
  * is close enough to suggest. */
 const char *mf_did_you_mean(const char *word, const char *const *candidates, size_t n);
 
+#pragma GCC visibility pop
 #endif

@@ -18,6 +18,7 @@
  */
 #ifndef MF_MODULES_H
 #define MF_MODULES_H
+#pragma GCC visibility push(default) /* the plugin API (an installed header) */
 
 #include <stdbool.h>
 #include <stdint.h>
@@ -245,4 +246,5 @@ int mf_pressure_solve_rows(mf_module *m, const mf_sim *sim, const char *field, c
 /* One step of the solver module: the time, the fault-injection point. */
 int mf_solver_step(mf_module *solver, mf_sim *sim, double dt);
 
+#pragma GCC visibility pop
 #endif

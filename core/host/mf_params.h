@@ -9,6 +9,7 @@
  */
 #ifndef MF_PARAMS_H
 #define MF_PARAMS_H
+#pragma GCC visibility push(default) /* the plugin API (an installed header) */
 
 #include <stdbool.h>
 #include <stddef.h>
@@ -65,4 +66,5 @@ typedef struct mf_param_section {
     size_t nparams;
 } mf_param_section;
 
+#pragma GCC visibility pop
 #endif

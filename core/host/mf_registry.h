@@ -22,6 +22,7 @@
  */
 #ifndef MF_REGISTRY_H
 #define MF_REGISTRY_H
+#pragma GCC visibility push(default) /* the plugin API (an installed header) */
 
 #include <stddef.h>
 #include <stdio.h>
@@ -85,4 +86,5 @@ void mf_registry_set_plugin_dir(mf_registry *reg, const char *dir);
 const char *mf_module_kind_name(mf_module_kind kind);   /* "solver", "pressure", ... */
 void mf_registry_print(const mf_registry *reg, FILE *f); /* `mpsflow modules` */
 
+#pragma GCC visibility pop
 #endif

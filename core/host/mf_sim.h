@@ -5,6 +5,7 @@
  * particles; function objects and writers only read. */
 #ifndef MF_SIM_H
 #define MF_SIM_H
+#pragma GCC visibility push(default) /* the plugin API (an installed header) */
 
 #include <stdbool.h>
 #include <stddef.h>
@@ -133,4 +134,5 @@ static inline double mf_sim_particle_mass(const mf_sim *sim, int fluid_field, si
     return sim->fluid[f].rho * vol;
 }
 
+#pragma GCC visibility pop
 #endif

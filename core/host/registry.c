@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_alloc.h"
 #include "mf_error.h"
 #include "mf_modules.h" /* mf_ops_size */
 
@@ -71,10 +72,8 @@ static int upgrade_table(mf_registry *reg, const mf_module_info *m, const mf_mod
                         kind_names[m->kind], m->abi_version);
     if (reg->nupgraded == reg->cap_upgraded) {
         size_t cap = reg->cap_upgraded ? 2 * reg->cap_upgraded : 8;
-        void **grown = realloc(reg->upgraded, cap * sizeof *grown);
-        if (!grown)
+        if (mf_resize(&reg->upgraded, cap, sizeof *reg->upgraded))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory registering '%s'", m->name);
-        reg->upgraded = grown;
         reg->cap_upgraded = cap;
     }
     void *copy = calloc(1, now);
@@ -113,10 +112,8 @@ int mf_registry_add(mf_registry *reg, const mf_module_info *m)
                             kind_names[k], m->name);
     if (reg->n[k] == reg->cap[k]) {
         size_t cap = reg->cap[k] ? 2 * reg->cap[k] : 8;
-        const mf_module_info **grown = realloc(reg->mod[k], cap * sizeof *grown);
-        if (!grown)
+        if (mf_resize(&reg->mod[k], cap, sizeof *reg->mod[k]))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory registering '%s'", m->name);
-        reg->mod[k] = grown;
         reg->cap[k] = cap;
     }
     const mf_module_info *table = m;

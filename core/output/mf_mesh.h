@@ -11,11 +11,13 @@
  * The functions are static inline so that core needs no new object file. */
 #ifndef MF_MESH_H
 #define MF_MESH_H
+#pragma GCC visibility push(default) /* the plugin API (an installed header) */
 
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_alloc.h"
 #include "mf_error.h"
 
 typedef struct mf_mesh {
@@ -50,21 +52,15 @@ static inline int mf_mesh_reserve(mf_mesh *m, size_t nverts, size_t ntris)
         return MF_ERROR(MF_ERR_MEMORY, "a mesh of %zu vertices and %zu triangles is too large",
                         nverts, ntris);
     if (nverts > m->cap_verts) {
-        float *xyz = realloc(m->xyz, 3 * nverts * sizeof *xyz);
-        if (!xyz)
+        if (mf_resize(&m->xyz, 3 * nverts, sizeof *m->xyz))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu mesh vertices", nverts);
-        m->xyz = xyz;
-        float *nrm = realloc(m->normal, 3 * nverts * sizeof *nrm);
-        if (!nrm)
+        if (mf_resize(&m->normal, 3 * nverts, sizeof *m->normal))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu mesh normals", nverts);
-        m->normal = nrm;
         m->cap_verts = nverts;
     }
     if (ntris > m->cap_tris) {
-        int32_t *tri = realloc(m->tri, 3 * ntris * sizeof *tri);
-        if (!tri)
+        if (mf_resize(&m->tri, 3 * ntris, sizeof *m->tri))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu mesh triangles", ntris);
-        m->tri = tri;
         m->cap_tris = ntris;
     }
     return 0;
@@ -75,4 +71,5 @@ static inline size_t mf_mesh_memory(const mf_mesh *m)
     return m->cap_verts * 6 * sizeof(float) + m->cap_tris * 3 * sizeof(int32_t);
 }
 
+#pragma GCC visibility pop
 #endif

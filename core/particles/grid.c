@@ -37,8 +37,7 @@ void mf_grid_free(mf_grid *g)
     free(g->cell_start);
     free(g->cell_rows);
     free(g->order);
-    free(g->hash_key);
-    free(g->hash_cell);
+    mf_hashmap_free(&g->cells);
     free(g->spos);
     free_sort_buffers(g);
     mf_grid_init(g);
@@ -136,33 +135,6 @@ static int ensure_cell_buffers(mf_grid *g, size_t ncells, int rows)
     return 0;
 }
 
-/* Table of capacity a power of two >= 2 * ncells (load <= 1/2 keeps probe
- * sequences short); reused unless more than 4 times too large. */
-static int ensure_hash(mf_grid *g, size_t ncells)
-{
-    size_t need = 16;
-    while (need < 2 * ncells) {
-        if (need > SIZE_MAX / 2)
-            return MF_ERROR(MF_ERR_MEMORY, "hash table for %zu cells is too large", ncells);
-        need *= 2;
-    }
-    if (!g->hash_key || g->hash_cap < need || g->hash_cap > 4 * need) {
-        int rc = 0;
-        g->hash_cap = 0;
-        if ((rc = replace_buffer((void **)&g->hash_key, need, sizeof(uint64_t), "hash keys")) ||
-            (rc = replace_buffer((void **)&g->hash_cell, need, sizeof(uint32_t), "hash cells"))) {
-            free(g->hash_key);
-            free(g->hash_cell);
-            g->hash_key = NULL;
-            g->hash_cell = NULL;
-            return mf_error_trace(rc, __FILE__, __LINE__, __func__);
-        }
-        g->hash_cap = need;
-    }
-    /* All bytes 0xFF gives UINT32_MAX, the empty mark. */
-    memset(g->hash_cell, 0xFF, g->hash_cap * sizeof(uint32_t));
-    return 0;
-}
 
 size_t mf_grid_memory(const mf_grid *g)
 {
@@ -173,34 +145,18 @@ size_t mf_grid_memory(const mf_grid *g)
     size_t per_cell = sizeof(uint64_t) + sizeof(uint32_t) + g->alloc_rows * sizeof(uint32_t);
     if (g->cell_start)
         bytes += g->alloc_cells * per_cell + sizeof(uint32_t);
-    bytes += g->hash_cap * (sizeof(uint64_t) + sizeof(uint32_t));
+    bytes += mf_hashmap_memory(&g->cells);
     return bytes;
 }
 
 /* ---- grid: cells and hash table ------------------------------------------ */
 
-static void hash_insert(mf_grid *g, uint64_t key, uint32_t cell)
-{
-    size_t mask = g->hash_cap - 1;
-    size_t h = (size_t)mix64(key) & mask;
-    while (g->hash_cell[h] != EMPTY_SLOT)
-        h = (h + 1) & mask;
-    g->hash_key[h] = key;
-    g->hash_cell[h] = cell;
-}
-
 long mf_grid_find_cell(const mf_grid *g, uint64_t key)
 {
     if (!g || g->ncells == 0)
         return -1;
-    size_t mask = g->hash_cap - 1;
-    size_t h = (size_t)mix64(key) & mask;
-    while (g->hash_cell[h] != EMPTY_SLOT) {
-        if (g->hash_key[h] == key)
-            return (long)g->hash_cell[h];
-        h = (h + 1) & mask;
-    }
-    return -1;
+    uint32_t c = mf_hashmap_get(&g->cells, key);
+    return c == MF_HASHMAP_EMPTY ? -1 : (long)c;
 }
 
 /* Integer cell coordinate of x on one axis; the same expression is used
@@ -283,8 +239,7 @@ static void make_empty(mf_grid *g)
     g->ncells = 0;
     if (g->cell_start)
         g->cell_start[0] = 0;
-    if (g->hash_cell)
-        memset(g->hash_cell, 0xFF, g->hash_cap * sizeof(uint32_t));
+    mf_hashmap_clear(&g->cells);
 }
 
 /* Bounding box of the first n particles; fails on a non-finite coordinate
@@ -502,7 +457,9 @@ int mf_grid_build_reach(mf_grid *g, const mf_particles *p, double cell_size, int
         ncells += skey[k] != skey[k - 1];
     const int nrows = rows_per_cell(dim, reach);
     MF_CALL_GOTO(rc, ensure_cell_buffers(g, ncells, nrows), fail);
-    MF_CALL_GOTO(rc, ensure_hash(g, ncells), fail);
+    /* at most half full: short probe sequences; reused unless more than 4
+     * times too large */
+    MF_CALL_GOTO(rc, mf_hashmap_reset(&g->cells, 2 * ncells, 4), fail);
 
     /* Cells: starts and public keys. */
     {
@@ -522,7 +479,7 @@ int mf_grid_build_reach(mf_grid *g, const mf_particles *p, double cell_size, int
     }
     g->ncells = ncells;
     for (size_t c = 0; c < ncells; c++)
-        hash_insert(g, g->cell_key[c], (uint32_t)c);
+        mf_hashmap_put_new(&g->cells, g->cell_key[c], (uint32_t)c);
 
     /* Rows of neighbouring cells, once per cell for all later list builds. */
 #pragma omp parallel for schedule(static)

@@ -1,6 +1,8 @@
 /* kernel.c: n0 and lambda from an ideal full lattice (eqs. 3, 8). */
 #include "mf_kernel.h"
 
+#include <math.h>
+
 #include "mf_error.h"
 
 int mf_kernel_init(mf_kernel *k, int dim, double l0, double re)
@@ -13,7 +15,7 @@ int mf_kernel_init(mf_kernel *k, int dim, double l0, double re)
                         l0);
     int m = (int)ceil(re / l0);
     int mz = dim == 3 ? m : 0;
-    double n0 = 0.0, r2w = 0.0;
+    double n0 = 0.0, r2w = 0.0, r2hl = 0.0, half_y = 0.0;
     for (int ix = -m; ix <= m; ix++)
         for (int iy = -m; iy <= m; iy++)
             for (int iz = -mz; iz <= mz; iz++) {
@@ -21,11 +23,16 @@ int mf_kernel_init(mf_kernel *k, int dim, double l0, double re)
                 double w = mf_weight(r, re);
                 n0 += w;
                 r2w += r * r * w;
+                r2hl += r * r * mf_weight_hl(r, re, dim);
+                if (iy < 0 && r > 0.0)
+                    half_y += l0 * iy / r * w;
             }
     k->dim = dim;
     k->l0 = l0;
     k->re = re;
     k->n0 = n0;
     k->lambda = r2w / n0; /* eq. 8 on the lattice */
+    k->hl_coef = 2.0 * dim / r2hl;
+    k->asym_flat = fabs(half_y) / n0;
     return 0;
 }

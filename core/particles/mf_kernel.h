@@ -6,6 +6,7 @@
  * are the same bit for bit whichever loop runs them. */
 #ifndef MF_KERNEL_H
 #define MF_KERNEL_H
+#pragma GCC visibility push(default) /* the plugin API (an installed header) */
 
 #include <math.h>
 
@@ -57,16 +58,53 @@ static inline double mf_divergence_term(double du_dot_r, double w, double len)
     return du_dot_r * w / (len * len);
 }
 
+/* The higher-order Laplacian of Khayyer & Gotoh (2010, Appl. Ocean Res. 32,
+ * 124-131, eq. 20 in 2-D; 2012, Appl. Ocean Res. 37, 120-126, in 3-D): the
+ * pair weight d^2w/dr^2 + (d - 3)/r dw/dr of w = re/r - 1, which is
+ * (5 - d) re / r^3 for r < re. The papers scale the sum by 1/n0; on the
+ * ideal lattice that gives <lap |x|^2> = 2d times 1.86 (2-D) or 1.08 (3-D)
+ * at re = 3.1 l0, so here the scale comes from the lattice as lambda does for
+ * eq. 7 (mf_kernel.hl_coef): the operator is exact for a quadratic there. */
+static inline double mf_weight_hl(double r, double re, int dim)
+{
+    return (r > 0.0 && r < re) ? (5.0 - dim) * re / (r * r * r) : 0.0;
+}
+
+/* The time derivative of one pair's weight, dw/dt = dw/dr (r_ij . u_ij) /
+ * |r_ij| = -re (r_ij . u_ij) / |r_ij|^3 (u_ij = u_j - u_i): the pair term of
+ * Dn/Dt in the higher-order source term of Khayyer & Gotoh (2009, Coastal
+ * Eng. 56, 419-440, eq. 11). */
+static inline double mf_weight_rate_term(double r_dot_du, double len, double re)
+{
+    return (len > 0.0 && len < re) ? -re * r_dot_du / (len * len * len) : 0.0;
+}
+
+/* The weight of the least-squares operators (LSMPS, Tamai & Koshizuka 2014,
+ * Comp. Part. Mech. 1, 277-305, eq. 15): (1 - r/re)^2 for r < re. */
+static inline double mf_weight_ls(double r, double re)
+{
+    return (r > 0.0 && r < re) ? (1.0 - r / re) * (1.0 - r / re) : 0.0;
+}
+
 typedef struct mf_kernel {
     int dim;
     double l0;     /* initial particle spacing */
     double re;     /* interaction radius */
     double n0;     /* number density of a full interior lattice particle */
     double lambda; /* eq. 8, same lattice */
+    /* 2d / sum_j |r_ij|^2 mf_weight_hl(|r_ij|) on the same lattice: the
+     * scale of the higher-order Laplacian, <lap f>_i = hl_coef sum_j (f_j -
+     * f_i) mf_weight_hl(|r_ij|). */
+    double hl_coef;
+    /* |sum_j r_ij/|r_ij| w_ij| / n0 for a particle on the flat free surface
+     * of a half lattice (the neighbours with y <= 0): the scale of the
+     * neighbour-asymmetry test of free-surface detection. */
+    double asym_flat;
 } mf_kernel;
 
-/* n0 and lambda from the ideal full lattice (2-D square, 3-D cubic) of
- * spacing l0, every lattice point within re of the origin. */
+/* n0, lambda, hl_coef and asym_flat from the ideal full lattice (2-D square,
+ * 3-D cubic) of spacing l0, every lattice point within re of the origin. */
 int mf_kernel_init(mf_kernel *k, int dim, double l0, double re);
 
+#pragma GCC visibility pop
 #endif

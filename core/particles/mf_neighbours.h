@@ -27,11 +27,13 @@
  */
 #ifndef MF_NEIGHBOURS_H
 #define MF_NEIGHBOURS_H
+#pragma GCC visibility push(default) /* the plugin API (an installed header) */
 
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
+#include "mf_hashmap.h"
 #include "mf_particles.h"
 
 typedef struct mf_grid {
@@ -44,10 +46,8 @@ typedef struct mf_grid {
     uint64_t *cell_key;    /* ncells, ascending */
     uint32_t *cell_start;  /* ncells + 1: particles of cell c are order[cell_start[c] .. cell_start[c+1]) */
     uint32_t *order;       /* np: particle indices sorted by cell */
-    /* key -> cell index, open addressing with linear probing */
-    size_t hash_cap;       /* power of two, >= 2 * ncells */
-    uint64_t *hash_key;
-    uint32_t *hash_cell;   /* UINT32_MAX marks an empty slot */
+    mf_hashmap cells;      /* key -> cell index; >= 2 * ncells slots (the layout of
+                              the hash_cap, hash_key, hash_cell it replaced) */
     size_t alloc_np, alloc_cells, alloc_rows, alloc_sort; /* capacities, reused between builds */
     size_t nbox[3];        /* bounding box size in cells per axis (nbox[2] = 1 in 2-D) */
     double *spos;          /* 3 * alloc_np: positions in cell order (order[k]'s at k),
@@ -174,4 +174,5 @@ typedef struct mf_neighbours_stats {
 } mf_neighbours_stats;
 void mf_neighbours_get_stats(const mf_neighbours *nb, mf_neighbours_stats *out);
 
+#pragma GCC visibility pop
 #endif

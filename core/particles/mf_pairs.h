@@ -28,6 +28,7 @@
  */
 #ifndef MF_PAIRS_H
 #define MF_PAIRS_H
+#pragma GCC visibility push(default) /* the plugin API (an installed header) */
 
 #include <math.h>
 #include <stdbool.h>
@@ -322,4 +323,5 @@ MF_ENGINE void mf_grid_near(const mf_grid *g, const double x[3], mf_point_kernel
             }
 }
 
+#pragma GCC visibility pop
 #endif

@@ -16,6 +16,7 @@
  */
 #ifndef MF_PARTICLES_H
 #define MF_PARTICLES_H
+#pragma GCC visibility push(default) /* the plugin API (an installed header) */
 
 #include <stdbool.h>
 #include <stddef.h>
@@ -106,4 +107,5 @@ size_t mf_particles_memory(const mf_particles *p); /* bytes held */
  * memory measured on the tutorials. */
 double mf_memory_per_particle(int dim, double radius_l0);
 
+#pragma GCC visibility pop
 #endif

@@ -1,6 +1,7 @@
 /* mf_timestep.h: time-step limits (Courant, viscous, user maximum). */
 #ifndef MF_TIMESTEP_H
 #define MF_TIMESTEP_H
+#pragma GCC visibility push(default) /* the plugin API (an installed header) */
 
 #include "mf_particles.h"
 
@@ -19,4 +20,5 @@ void mf_courant(const mf_particles *p, double dt, double l0, double *mean, doubl
 void mf_dt_choose(double l0, double umax, double courant, double nu, double viscous,
                   double dt_max, mf_dt_choice *out);
 
+#pragma GCC visibility pop
 #endif

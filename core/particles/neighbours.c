@@ -27,8 +27,9 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
+#include "mf_alloc.h"
+#include "mf_clock.h"
 #include "mf_error.h"
 #include "mf_pairs.h"
 
@@ -81,13 +82,6 @@ struct mf_neighbours {
     mf_grid points;     /* mf_neighbours_grid */
     mf_neighbours_stats stats;
 };
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 int mf_neighbours_create(mf_neighbours **out)
 {
@@ -142,10 +136,8 @@ static int class_of(mf_neighbours *nb, double cell, int *out)
         }
     if (nb->nclasses == nb->cap_classes) {
         int cap = 2 * nb->cap_classes + 4;
-        nb_class *grown = realloc(nb->cls, (size_t)cap * sizeof *grown);
-        if (!grown)
+        if (mf_resize(&nb->cls, (size_t)cap, sizeof *nb->cls))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for neighbour lists");
-        nb->cls = grown;
         nb->cap_classes = cap;
     }
     nb_class *c = &nb->cls[nb->nclasses];
@@ -181,10 +173,8 @@ int mf_neighbours_request(mf_neighbours *nb, double radius, double cell, int *ha
                         radius, cell);
     if (nb->nhandles == nb->cap_handles) {
         int cap = 2 * nb->cap_handles + 8;
-        nb_handle *grown = realloc(nb->handle, (size_t)cap * sizeof *grown);
-        if (!grown)
+        if (mf_resize(&nb->handle, (size_t)cap, sizeof *nb->handle))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for neighbour requests");
-        nb->handle = grown;
         nb->cap_handles = cap;
     }
     nb_handle *h = &nb->handle[nb->nhandles];
@@ -272,10 +262,8 @@ static int build(mf_neighbours *nb, nb_class *c, const mf_particles *p)
     const size_t np = p->n;
     if (np > c->cap_id) {
         size_t cap = np + np / 8 + 16;
-        int64_t *grown = realloc(c->id0, cap * sizeof *grown);
-        if (!grown)
+        if (mf_resize(&c->id0, cap, sizeof *c->id0))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu particle ids", np);
-        c->id0 = grown;
         c->cap_id = cap;
     }
     for (size_t k = 0; k < np; k++)
@@ -294,7 +282,7 @@ static int build(mf_neighbours *nb, nb_class *c, const mf_particles *p)
 static int refresh(mf_neighbours *nb, nb_class *c, const mf_particles *p, double r,
                    double *dmax)
 {
-    const double t0 = now();
+    const double t0 = mf_wall_seconds();
     int rc = 0;
     nb->stats.checks++;
     const double d = displacement(c, p);
@@ -329,7 +317,7 @@ static int refresh(mf_neighbours *nb, nb_class *c, const mf_particles *p, double
         rc = build(nb, c, p);
     }
     *dmax = kept ? d : 0.0; /* a fresh build: nothing has moved */
-    nb->stats.seconds += now() - t0;
+    nb->stats.seconds += mf_wall_seconds() - t0;
     return rc == 0 ? 0 : mf_error_trace(rc, __FILE__, __LINE__, __func__);
 }
 
@@ -376,10 +364,10 @@ int mf_neighbours_grid(mf_neighbours *nb, const mf_particles *p, double cell,
 {
     if (!nb)
         return MF_ERROR(MF_ERR_INPUT, "the run has no neighbour service (mf_neighbours_create)");
-    const double t0 = now();
+    const double t0 = mf_wall_seconds();
     int rc = mf_grid_build(&nb->points, p, cell);
     mf_grid_release_scratch(&nb->points);
-    nb->stats.seconds += now() - t0;
+    nb->stats.seconds += mf_wall_seconds() - t0;
     MF_CALL(rc);
     *out = &nb->points;
     return 0;
@@ -391,13 +379,13 @@ int mf_neighbours_locality_order(mf_neighbours *nb, const mf_particles *p, int h
     nb_handle *h = NULL;
     nb_class *c = NULL;
     MF_CALL(handle_class(nb, handle, &h, &c));
-    const double t0 = now();
+    const double t0 = mf_wall_seconds();
     c->list_radius = 0; /* the particles are about to move to other slots */
     int rc = mf_grid_build(&c->grid, p, c->cell);
     if (rc == 0)
         rc = mf_grid_locality_order(&c->grid, perm);
     mf_grid_release_scratch(&c->grid);
-    nb->stats.seconds += now() - t0;
+    nb->stats.seconds += mf_wall_seconds() - t0;
     MF_CALL(rc);
     return 0;
 }

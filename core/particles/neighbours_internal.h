@@ -35,18 +35,6 @@
 
 /* ---- small helpers ------------------------------------------------------ */
 
-/* splitmix64 finalizer: consecutive keys (neighbouring cells) land far apart
- * in the table. */
-static inline uint64_t mix64(uint64_t x)
-{
-    x ^= x >> 30;
-    x *= 0xbf58476d1ce4e5b9ULL;
-    x ^= x >> 27;
-    x *= 0x94d049bb133111ebULL;
-    x ^= x >> 31;
-    return x;
-}
-
 /* Bits needed to store values 0 .. n-1. */
 static inline int bits_for(uint64_t n)
 {

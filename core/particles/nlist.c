@@ -23,6 +23,7 @@
  * the radius) the fill pass repeats the distance test instead.
  */
 #include "neighbours_internal.h"
+#include "mf_alloc.h"
 
 /* ---- neighbour lists: memory ---------------------------------------------- */
 
@@ -588,11 +589,9 @@ static int plan_bits(mf_nlist *nl, list_build *lb)
     const size_t need = (ncells + 1) * sizeof(size_t) + total * sizeof(uint64_t);
     if (nl->work_bytes < need) { /* grow, keeping the offsets just planned */
         size_t cap = with_headroom(need);
-        void *grown = realloc(nl->work, cap);
-        if (!grown)
+        if (mf_resize(&nl->work, cap, 1))
             return MF_ERROR(MF_ERR_MEMORY, "cannot allocate neighbour list scratch (%zu bytes)",
                             cap);
-        nl->work = grown;
         nl->work_bytes = cap;
         cell_word = nl->work;
         lb->cell_word = cell_word;

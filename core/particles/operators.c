@@ -101,6 +101,63 @@ static inline bool grad_pair_rho(void *acc, const void *ctx, const mf_pair *pr)
     return grad_pair(acc, ctx, pr, COEF_RHO);
 }
 
+/* The corrected gradient (CMPS, Khayyer & Gotoh 2008, Coastal Eng. 55,
+ * 236-250, eq. 11): ((f_i + f_j) - (f^_i + f^_j)) c_ij w / |r_ij|^2 r_ij,
+ * antisymmetric in i and j, so that the pair forces cancel (linear and
+ * angular momentum). f^ is o->fhat (mf_neighbour_min). */
+static inline bool cgrad_pair(void *acc, const void *ctx, const mf_pair *pr, int mode)
+{
+    const grad_ctx *c = ctx;
+    const mf_gradient_opts *o = c->o;
+    grad_acc *a = acc;
+    if (pr->len <= 0.0)
+        return true;
+    const double cij = mode == COEF_RHO ? mf_inv_rho_pair(o->rho[pr->i], o->rho[pr->j],
+                                                          o->rho_average)
+                       : mode == COEF_CONSTANT ? o->coef
+                                               : 1.0;
+    const double df = (o->f[pr->i] + o->f[pr->j]) - (o->fhat[pr->i] + o->fhat[pr->j]);
+    const double s = mf_gradient_term(df, cij, mf_weight(pr->len, c->v->radius), pr->len);
+    a->g[0] += s * pr->r[0];
+    a->g[1] += s * pr->r[1];
+    a->g[2] += s * pr->r[2];
+    return true;
+}
+
+static inline bool cgrad_pair_one(void *acc, const void *ctx, const mf_pair *pr)
+{
+    return cgrad_pair(acc, ctx, pr, COEF_ONE);
+}
+
+static inline bool cgrad_pair_constant(void *acc, const void *ctx, const mf_pair *pr)
+{
+    return cgrad_pair(acc, ctx, pr, COEF_CONSTANT);
+}
+
+static inline bool cgrad_pair_rho(void *acc, const void *ctx, const mf_pair *pr)
+{
+    return cgrad_pair(acc, ctx, pr, COEF_RHO);
+}
+
+static inline void cgrad_row(const void *ctx, size_t i, int mode)
+{
+    const grad_ctx *c = ctx;
+    grad_acc a = {0.0, {0.0, 0.0, 0.0}};
+    if (mode == COEF_RHO)
+        mf_pairs_row(c->v, i, c->jmask, cgrad_pair_rho, c, &a);
+    else if (mode == COEF_CONSTANT)
+        mf_pairs_row(c->v, i, c->jmask, cgrad_pair_constant, c, &a);
+    else
+        mf_pairs_row(c->v, i, c->jmask, cgrad_pair_one, c, &a);
+    c->out[3 * i + 0] = c->coef * a.g[0];
+    c->out[3 * i + 1] = c->coef * a.g[1];
+    c->out[3 * i + 2] = c->coef * a.g[2];
+}
+
+static void cgrad_row_one(const void *ctx, size_t i) { cgrad_row(ctx, i, COEF_ONE); }
+static void cgrad_row_constant(const void *ctx, size_t i) { cgrad_row(ctx, i, COEF_CONSTANT); }
+static void cgrad_row_rho(const void *ctx, size_t i) { cgrad_row(ctx, i, COEF_RHO); }
+
 static inline void grad_row(const void *ctx, size_t i, int mode)
 {
     const grad_ctx *c = ctx;
@@ -127,7 +184,14 @@ void mf_gradient_ex(const mf_pairs *v, const mf_kernel *k, const mf_gradient_opt
                     const uint8_t *imask, const uint8_t *jmask, double *out)
 {
     const grad_ctx c = {v, o, jmask, k->dim / k->n0, out};
-    if (o->rho)
+    if (o->fhat) { /* corrected (CMPS) */
+        if (o->rho)
+            mf_pairs_each(v, imask, cgrad_row_rho, &c);
+        else if (o->coef == 1.0)
+            mf_pairs_each(v, imask, cgrad_row_one, &c);
+        else
+            mf_pairs_each(v, imask, cgrad_row_constant, &c);
+    } else if (o->rho)
         mf_pairs_each(v, imask, grad_row_rho, &c);
     else if (o->coef == 1.0)
         mf_pairs_each(v, imask, grad_row_one, &c);
@@ -140,6 +204,43 @@ void mf_gradient(const mf_pairs *v, const mf_kernel *k, const double *f, bool us
 {
     const mf_gradient_opts o = {.f = f, .use_min = use_min, .coef = 1.0};
     mf_gradient_ex(v, k, &o, imask, jmask, out);
+}
+
+/* f^_i: f_i, or the minimum of f over i and its neighbours (the p_min of
+ * eq. 5), except for the particles of own_reference. */
+typedef struct {
+    const mf_pairs *v;
+    const double *f;
+    const uint8_t *jmask, *own_reference;
+    bool use_min;
+    double *out;
+} min_ctx;
+
+static inline bool fmin_pair(void *acc, const void *ctx, const mf_pair *pr)
+{
+    const min_ctx *c = ctx;
+    double *fhat = acc;
+    const double fj = c->f[pr->j];
+    if (fj < *fhat)
+        *fhat = fj;
+    return true;
+}
+
+static void fmin_row(const void *ctx, size_t i)
+{
+    const min_ctx *c = ctx;
+    double fhat = c->f[i];
+    if (c->use_min && !(c->own_reference && c->own_reference[i]))
+        mf_pairs_row_r2(c->v, i, c->jmask, fmin_pair, c, &fhat);
+    c->out[i] = fhat;
+}
+
+void mf_neighbour_min(const mf_pairs *v, const double *f, bool use_min,
+                      const uint8_t *own_reference, const uint8_t *imask, const uint8_t *jmask,
+                      double *fhat)
+{
+    const min_ctx c = {v, f, jmask, own_reference, use_min, fhat};
+    mf_pairs_each(v, imask, fmin_row, &c);
 }
 
 /* ---- Laplacian ----------------------------------------------------------- */
@@ -155,16 +256,20 @@ typedef struct {
     const double *mu, *rho;
     const uint8_t *mu_mask;
     int mu_average;
+    int dim;      /* the higher-order Laplacian's weight */
     double *out;
 } lap_ctx;
 
-/* c_ij (f_j - f_i) w for ncomp components (a literal at the call sites);
- * c_ij = 1, or mu_ij with a pair viscosity. */
-static inline bool lap_pair(void *acc, const void *ctx, const mf_pair *pr, int ncomp, bool mu)
+/* c_ij (f_j - f_i) w for ncomp components (literals at the call sites, as
+ * hl); c_ij = 1, or mu_ij with a pair viscosity; w the weight of eq. 3, or
+ * with hl that of the higher-order Laplacian (mf_weight_hl). */
+static inline bool lap_pair_as(void *acc, const void *ctx, const mf_pair *pr, int ncomp, bool mu,
+                               bool hl)
 {
     const lap_ctx *c = ctx;
     double *a = acc;
-    const double w = mf_weight(pr->len, c->v->radius);
+    const double w = hl ? mf_weight_hl(pr->len, c->v->radius, c->dim)
+                        : mf_weight(pr->len, c->v->radius);
     if (w <= 0.0)
         return true; /* its term is zero */
     const size_t i = pr->i, j = pr->j;
@@ -180,6 +285,11 @@ static inline bool lap_pair(void *acc, const void *ctx, const mf_pair *pr, int n
         a[0] += mf_laplacian_term(cij, f[j] - f[i], w);
     }
     return true;
+}
+
+static inline bool lap_pair(void *acc, const void *ctx, const mf_pair *pr, int ncomp, bool mu)
+{
+    return lap_pair_as(acc, ctx, pr, ncomp, mu, false);
 }
 
 static inline bool lap1_pair(void *acc, const void *ctx, const mf_pair *pr)
@@ -232,6 +342,86 @@ static void lap3_mu_row(const void *ctx, size_t i)
     mf_pairs_row(c->v, i, NULL, lap3_mu_pair, c, a);
     for (int q = 0; q < 3; q++)
         c->out[3 * i + q] += c->coef * a[q] / c->rho[i];
+}
+
+/* ---- the higher-order Laplacian (mf_weight_hl) ---------------------------- */
+
+static inline bool hl1_pair(void *acc, const void *ctx, const mf_pair *pr)
+{
+    return lap_pair_as(acc, ctx, pr, 1, false, true);
+}
+
+static inline bool hl3_pair(void *acc, const void *ctx, const mf_pair *pr)
+{
+    return lap_pair_as(acc, ctx, pr, 3, false, true);
+}
+
+static inline bool hl3_mu_pair(void *acc, const void *ctx, const mf_pair *pr)
+{
+    return lap_pair_as(acc, ctx, pr, 3, true, true);
+}
+
+static void hl1_row(const void *ctx, size_t i)
+{
+    const lap_ctx *c = ctx;
+    double a = 0.0;
+    mf_pairs_row(c->v, i, c->jmask, hl1_pair, c, &a);
+    c->out[i] = c->coef * a;
+}
+
+static void hl3_row(const void *ctx, size_t i)
+{
+    const lap_ctx *c = ctx;
+    double a[3] = {0.0, 0.0, 0.0};
+    mf_pairs_row(c->v, i, c->jmask, hl3_pair, c, a);
+    for (int q = 0; q < 3; q++)
+        c->out[3 * i + q] = c->coef * a[q];
+}
+
+static void hl3_add_row(const void *ctx, size_t i)
+{
+    const lap_ctx *c = ctx;
+    double a[3] = {0.0, 0.0, 0.0};
+    mf_pairs_row(c->v, i, c->jmask, hl3_pair, c, a);
+    for (int q = 0; q < 3; q++)
+        c->out[3 * i + q] += c->scale * (c->coef * a[q]);
+}
+
+static void hl3_mu_row(const void *ctx, size_t i)
+{
+    const lap_ctx *c = ctx;
+    double a[3] = {0.0, 0.0, 0.0};
+    mf_pairs_row(c->v, i, NULL, hl3_mu_pair, c, a);
+    for (int q = 0; q < 3; q++)
+        c->out[3 * i + q] += c->coef * a[q] / c->rho[i];
+}
+
+void mf_laplacian_hl(const mf_pairs *v, const mf_kernel *k, const double *f, int ncomp,
+                     const uint8_t *imask, const uint8_t *jmask, double *out)
+{
+    const lap_ctx c = {.v = v, .jmask = jmask, .f = f, .ncomp = ncomp, .coef = k->hl_coef,
+                       .dim = k->dim, .out = out};
+    if (ncomp == 3)
+        mf_pairs_each(v, imask, hl3_row, &c);
+    else
+        mf_pairs_each(v, imask, hl1_row, &c);
+}
+
+void mf_laplacian_hl_add(const mf_pairs *v, const mf_kernel *k, const double *f, double scale,
+                         const uint8_t *imask, const uint8_t *jmask, double *out)
+{
+    const lap_ctx c = {.v = v, .jmask = jmask, .f = f, .ncomp = 3, .coef = k->hl_coef,
+                       .scale = scale, .dim = k->dim, .out = out};
+    mf_pairs_each(v, imask, hl3_add_row, &c);
+}
+
+void mf_laplacian_hl_mu(const mf_pairs *v, const mf_kernel *k, const double *f, const double *mu,
+                        int mu_average, const uint8_t *mu_mask, const double *rho,
+                        const uint8_t *imask, double *out)
+{
+    const lap_ctx c = {.v = v, .f = f, .ncomp = 3, .coef = k->hl_coef, .mu = mu, .rho = rho,
+                       .mu_mask = mu_mask, .mu_average = mu_average, .dim = k->dim, .out = out};
+    mf_pairs_each(v, imask, hl3_mu_row, &c);
 }
 
 static double lap_coef(const mf_kernel *k)
@@ -302,6 +492,149 @@ void mf_divergence(const mf_pairs *v, const mf_kernel *k, const double *u,
 {
     const div_ctx c = {v, jmask, u, k->dim / k->n0, out};
     mf_pairs_each(v, imask, div_row, &c);
+}
+
+/* ---- rate of the number density (Khayyer & Gotoh 2009) ------------------- */
+
+typedef struct {
+    const mf_pairs *v;
+    const uint8_t *jmask;
+    const double *u;
+    double *out;
+} rate_ctx;
+
+static inline bool rate_pair(void *acc, const void *ctx, const mf_pair *pr)
+{
+    const rate_ctx *c = ctx;
+    const double *ui = c->u + 3 * pr->i, *uj = c->u + 3 * pr->j;
+    const double du = (uj[0] - ui[0]) * pr->r[0] + (uj[1] - ui[1]) * pr->r[1] +
+                      (uj[2] - ui[2]) * pr->r[2];
+    *(double *)acc += mf_weight_rate_term(du, pr->len, c->v->radius);
+    return true;
+}
+
+static void rate_row(const void *ctx, size_t i)
+{
+    const rate_ctx *c = ctx;
+    double sum = 0.0;
+    mf_pairs_row(c->v, i, c->jmask, rate_pair, c, &sum);
+    c->out[i] = sum;
+}
+
+void mf_number_density_rate(const mf_pairs *v, const double *u, const uint8_t *imask,
+                            const uint8_t *jmask, double *out)
+{
+    const rate_ctx c = {v, jmask, u, out};
+    mf_pairs_each(v, imask, rate_row, &c);
+}
+
+/* ---- sums of directions: asymmetry, concentration gradient --------------- */
+
+typedef struct {
+    const mf_pairs *v;
+    const uint8_t *jmask;
+    double coef;
+    double *out;
+} dir_ctx;
+
+/* r_ij/|r_ij| w_ij (unit) or r_ij w_ij/|r_ij|^2 (inverse) (a literal). */
+static inline bool dir_pair(void *acc, const void *ctx, const mf_pair *pr, bool inverse)
+{
+    const dir_ctx *c = ctx;
+    double *a = acc;
+    if (pr->len <= 0.0)
+        return true;
+    const double w = mf_weight(pr->len, c->v->radius);
+    const double s = inverse ? w / pr->r2 : w / pr->len;
+    a[0] += s * pr->r[0];
+    a[1] += s * pr->r[1];
+    a[2] += s * pr->r[2];
+    return true;
+}
+
+static inline bool unit_pair(void *acc, const void *ctx, const mf_pair *pr)
+{
+    return dir_pair(acc, ctx, pr, false);
+}
+
+static inline bool inverse_pair(void *acc, const void *ctx, const mf_pair *pr)
+{
+    return dir_pair(acc, ctx, pr, true);
+}
+
+static void unit_row(const void *ctx, size_t i)
+{
+    const dir_ctx *c = ctx;
+    double a[3] = {0.0, 0.0, 0.0};
+    mf_pairs_row(c->v, i, c->jmask, unit_pair, c, a);
+    for (int q = 0; q < 3; q++)
+        c->out[3 * i + q] = c->coef * a[q];
+}
+
+static void inverse_row(const void *ctx, size_t i)
+{
+    const dir_ctx *c = ctx;
+    double a[3] = {0.0, 0.0, 0.0};
+    mf_pairs_row(c->v, i, c->jmask, inverse_pair, c, a);
+    for (int q = 0; q < 3; q++)
+        c->out[3 * i + q] = c->coef * a[q];
+}
+
+void mf_neighbour_asymmetry(const mf_pairs *v, const mf_kernel *k, const uint8_t *imask,
+                            const uint8_t *jmask, double *out)
+{
+    const dir_ctx c = {v, jmask, 1.0 / k->n0, out};
+    mf_pairs_each(v, imask, unit_row, &c);
+}
+
+void mf_concentration_gradient(const mf_pairs *v, const mf_kernel *k, const uint8_t *imask,
+                               const uint8_t *jmask, double *out)
+{
+    const dir_ctx c = {v, jmask, k->dim / k->n0, out};
+    mf_pairs_each(v, imask, inverse_row, &c);
+}
+
+/* ---- velocity gradient ----------------------------------------------------- */
+
+typedef struct {
+    const mf_pairs *v;
+    const uint8_t *jmask;
+    const double *u;
+    double coef;
+    double *out;
+} vgrad_ctx;
+
+static inline bool vgrad_pair(void *acc, const void *ctx, const mf_pair *pr)
+{
+    const vgrad_ctx *c = ctx;
+    double *g = acc;
+    if (pr->len <= 0.0)
+        return true;
+    const double s = mf_weight(pr->len, c->v->radius) / pr->r2;
+    const double *ui = c->u + 3 * pr->i, *uj = c->u + 3 * pr->j;
+    for (int a = 0; a < 3; a++) {
+        const double du = s * (uj[a] - ui[a]);
+        g[3 * a + 0] += du * pr->r[0];
+        g[3 * a + 1] += du * pr->r[1];
+        g[3 * a + 2] += du * pr->r[2];
+    }
+    return true;
+}
+
+static void vgrad_row(const void *ctx, size_t i)
+{
+    const vgrad_ctx *c = ctx;
+    double g[9] = {0};
+    mf_pairs_row(c->v, i, c->jmask, vgrad_pair, c, g);
+    for (int q = 0; q < 9; q++)
+        c->out[9 * i + q] = c->coef * g[q];
+}
+
+void mf_velocity_gradient(const mf_pairs *v, const mf_kernel *k, const double *u,
+                          const uint8_t *imask, const uint8_t *jmask, double *out)
+{
+    const vgrad_ctx c = {v, jmask, u, k->dim / k->n0, out};
+    mf_pairs_each(v, imask, vgrad_row, &c);
 }
 
 /* ---- collision ----------------------------------------------------------- */

@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_alloc.h"
 #include "mf_error.h"
 
 /* A fresh store never starts smaller than this: tiny capacities only cost
@@ -121,12 +122,11 @@ int mf_particles_reserve(mf_particles *p, size_t cap)
         size_t bytes = checked_bytes(new_cap, refs[a].elem_size);
         if (bytes == 0)
             return MF_ERROR(MF_ERR_MEMORY, "particle capacity %zu is too large", new_cap);
-        void *grown = realloc(*refs[a].data, bytes);
-        if (!grown)
+        if (mf_resize(refs[a].data, bytes, 1))
             return MF_ERROR(MF_ERR_MEMORY,
                             "cannot grow particle arrays to %zu particles (%zu bytes)", new_cap,
                             bytes);
-        *refs[a].data = grown;
+        void *grown = *refs[a].data;
         if (a >= 4) { /* optional fields start at zero */
             size_t old_bytes = p->cap * refs[a].elem_size;
             memset((char *)grown + old_bytes, 0, bytes - old_bytes);

@@ -9,6 +9,7 @@
  */
 #ifndef MF_RUN_H
 #define MF_RUN_H
+#pragma GCC visibility push(default) /* the plugin API (an installed header) */
 
 #include <stdbool.h>
 
@@ -85,4 +86,5 @@ const char *mf_stop_at_name(mf_stop_at s);
 /* Peak resident memory of this process, bytes. */
 size_t mf_peak_memory(void);
 
+#pragma GCC visibility pop
 #endif

@@ -28,6 +28,7 @@
  */
 #ifndef MF_WATCH_H
 #define MF_WATCH_H
+#pragma GCC visibility push(default) /* the plugin API (an installed header) */
 
 #include <stdbool.h>
 
@@ -62,4 +63,5 @@ int mf_watch_check(mf_watch *w, const mf_sim *sim, double dt);
 /* The step was accepted: keep its energy bookkeeping. */
 void mf_watch_accept(mf_watch *w);
 
+#pragma GCC visibility pop
 #endif

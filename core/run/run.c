@@ -8,6 +8,7 @@
 #include <sys/resource.h>
 #include <time.h>
 
+#include "mf_alloc.h"
 #include "mf_emitter.h"
 #include "mf_error.h"
 #include "mf_timestep.h"
@@ -38,12 +39,14 @@ static int save_state(saved_state *s, const mf_particles *p, double time)
 {
     if (s->cap < p->n) {
         size_t cap = p->n + p->n / 4 + 16;
-        s->pos = realloc(s->pos, 3 * cap * sizeof(double));
-        s->vel = realloc(s->vel, 3 * cap * sizeof(double));
-        s->kind = realloc(s->kind, cap);
-        s->id = realloc(s->id, cap * sizeof(int64_t));
-        for (int f = 0; f < p->nfields; f++)
-            s->field[f] = realloc(s->field[f], field_bytes(&p->field[f], cap));
+        bool grown = mf_resize(&s->pos, 3 * cap, sizeof(double)) == 0 &&
+                     mf_resize(&s->vel, 3 * cap, sizeof(double)) == 0 &&
+                     mf_resize(&s->kind, cap, 1) == 0 &&
+                     mf_resize(&s->id, cap, sizeof(int64_t)) == 0;
+        for (int f = 0; grown && f < p->nfields; f++)
+            grown = mf_resize(&s->field[f], field_bytes(&p->field[f], cap), 1) == 0;
+        if (!grown)
+            return MF_ERROR(MF_ERR_MEMORY, "out of memory saving the state of step");
         s->cap = cap;
     }
     for (int f = 0; f < p->nfields; f++)

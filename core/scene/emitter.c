@@ -6,9 +6,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_alloc.h"
 #include "mf_error.h"
 #include "mf_params.h"
 #include "mf_scene.h"
+#include "scene_lattice.h"
 
 /* ======================================================================
  * Scalar profiles
@@ -332,11 +334,6 @@ static int axis_of(const double v[3], int dim, int *axis, int *sign)
     return 0;
 }
 
-static long lattice_count(double a, double b, double l0)
-{
-    return (long)floor((b - a) / l0 + 1e-9);
-}
-
 static int fluid_index(mf_sim *sim, const mf_dict *d, const char *name, int *fluid,
                        mf_dict *resolved)
 {
@@ -355,17 +352,6 @@ static int fluid_index(mf_sim *sim, const mf_dict *d, const char *name, int *flu
     return 0;
 }
 
-static int check_box(const char *what, const char *name, const mf_dict *d, const double *mn,
-                     const double *mx, int dim)
-{
-    char where[512];
-    for (int a = 0; a < dim; a++)
-        if (!(mx[a] > mn[a]))
-            return MF_ERROR(MF_ERR_INPUT, "%s: %s '%s': max must exceed min on every axis",
-                            mf_loc_str(d->loc, where, sizeof where), what, name);
-    return 0;
-}
-
 /* Fill the box [mn, mx] with particles of `kind` on the lattice; velocity
  * from the inlet profile (in != NULL) or v0; returns how many. */
 static int fill_box(mf_sim *sim, mf_emitters *em, int kind, const double *mn, const double *mx,
@@ -374,7 +360,7 @@ static int fill_box(mf_sim *sim, mf_emitters *em, int kind, const double *mn, co
     const double l0 = sim->l0;
     long hi[3] = {1, 1, 1};
     for (int a = 0; a < sim->dim; a++)
-        hi[a] = lattice_count(mn[a], mx[a], l0);
+        hi[a] = mf_lattice_count(mn[a], mx[a], l0);
     size_t before = sim->p->n;
     for (long k = 0; k < hi[2]; k++)
         for (long j = 0; j < hi[1]; j++)
@@ -404,7 +390,7 @@ static int add_inlet(mf_sim *sim, mf_emitters *em, const char *name, const mf_di
     mf_dict *r = resolved ? mf_dict_set_subdict(resolved, name) : NULL;
     MF_CALL(mf_params_apply(inlet_params, sizeof inlet_params / sizeof inlet_params[0], d, NULL,
                             &s, r));
-    MF_CALL(check_box("inlet", name, d, s.min, s.max, sim->dim));
+    MF_CALL(mf_lattice_check_box("inlet", name, d, s.min, s.max, sim->dim));
     mf_inlet *in = &em->inlet[em->ninlets];
     memset(in, 0, sizeof *in);
     snprintf(in->name, sizeof in->name, "%s", name);
@@ -443,7 +429,7 @@ static int add_outlet(mf_sim *sim, mf_emitters *em, const char *name, const mf_d
     mf_dict *r = resolved ? mf_dict_set_subdict(resolved, name) : NULL;
     MF_CALL(mf_params_apply(outlet_params, sizeof outlet_params / sizeof outlet_params[0], d,
                             NULL, &s, r));
-    MF_CALL(check_box("outlet", name, d, s.min, s.max, sim->dim));
+    MF_CALL(mf_lattice_check_box("outlet", name, d, s.min, s.max, sim->dim));
     mf_outlet *out = &em->outlet[em->noutlets];
     memset(out, 0, sizeof *out);
     snprintf(out->name, sizeof out->name, "%s", name);
@@ -732,10 +718,8 @@ static int grow_flags(mf_emitters *em, size_t n)
     if (n <= em->cap_flag)
         return 0;
     size_t cap = n + n / 4 + 64;
-    unsigned char *f = realloc(em->flag, cap);
-    if (!f)
+    if (mf_resize(&em->flag, cap, 1))
         return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu particle flags", n);
-    em->flag = f;
     em->cap_flag = cap;
     return 0;
 }

@@ -44,6 +44,7 @@
  */
 #ifndef MF_EMITTER_H
 #define MF_EMITTER_H
+#pragma GCC visibility push(default) /* the plugin API (an installed header) */
 
 #include <stdbool.h>
 #include <stddef.h>
@@ -184,4 +185,5 @@ void mf_inlet_velocity(const mf_inlet *in, int dim, const double x[3], double u[
 int mf_emitters_inlet_at(const mf_emitters *em, int dim, const double x[3], double margin);
 int mf_emitters_outlet_at(const mf_emitters *em, int dim, const double x[3], double margin);
 
+#pragma GCC visibility pop
 #endif

@@ -16,6 +16,7 @@
  */
 #ifndef MF_SCENE_H
 #define MF_SCENE_H
+#pragma GCC visibility push(default) /* the plugin API (an installed header) */
 
 #include "mf_dict.h"
 #include "mf_params.h"
@@ -93,4 +94,5 @@ extern const size_t mf_emitter_nsections;
 extern const mf_param_section mf_fluid_sections[];
 extern const size_t mf_fluid_nsections;
 
+#pragma GCC visibility pop
 #endif

@@ -61,6 +61,7 @@
  */
 #ifndef MF_TRIMESH_H
 #define MF_TRIMESH_H
+#pragma GCC visibility push(default) /* the plugin API (an installed header) */
 
 #include <stdbool.h>
 #include <stddef.h>
@@ -160,4 +161,5 @@ int mf_scene_mesh_fluid(mf_scene_meshes *sm, mf_sim *sim, const char *name, cons
 int mf_scene_mesh_wall(mf_scene_meshes *sm, mf_sim *sim, const char *name, const mf_dict *d,
                        bool obstacle, mf_dict *resolved);
 
+#pragma GCC visibility pop
 #endif

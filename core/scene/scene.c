@@ -6,10 +6,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_alloc.h"
 #include "mf_emitter.h"
 #include "mf_error.h"
 #include "mf_params.h"
 #include "mf_trimesh.h"
+#include "scene_lattice.h"
 
 /* ---- fluids -------------------------------------------------------------- */
 typedef struct fluid_settings {
@@ -179,24 +181,6 @@ static const mf_param wall_params[] = {
 };
 static const char *const wall_extra[] = {"open", NULL};
 
-/* Number of lattice points min + (i + 1/2) l0 that fit in [a, b]. The small
- * tolerance keeps (b - a) / l0 = 50 from rounding down to 49. */
-static long lattice_count(double a, double b, double l0)
-{
-    return (long)floor((b - a) / l0 + 1e-9);
-}
-
-static int check_box(const char *what, const char *name, const mf_dict *d, const double *mn,
-                     const double *mx, int dim)
-{
-    char where[512];
-    for (int a = 0; a < dim; a++)
-        if (!(mx[a] > mn[a]))
-            return MF_ERROR(MF_ERR_INPUT, "%s: %s '%s': max must exceed min on every axis",
-                            mf_loc_str(d->loc, where, sizeof where), what, name);
-    return 0;
-}
-
 /* A box needs min and max, a sphere its radius. */
 static int check_block_shape(const char *name, const mf_dict *d, bool sphere,
                              const block_settings *s, int dim)
@@ -212,7 +196,7 @@ static int check_block_shape(const char *name, const mf_dict *d, bool sphere,
     if (!mf_dict_find(d, "min") || !mf_dict_find(d, "max"))
         return MF_ERROR(MF_ERR_INPUT, "%s: fluid block '%s': type box needs 'min' and 'max'",
                         mf_loc_str(d->loc, where, sizeof where), name);
-    return check_box("fluid block", name, d, s->min, s->max, dim);
+    return mf_lattice_check_box("fluid block", name, d, s->min, s->max, dim);
 }
 
 /* The height of a box block's top face at x (a wave when topAmplitude != 0). */
@@ -282,7 +266,7 @@ static int add_fluid_block(mf_sim *sim, const char *name, const mf_dict *d, int 
         }
     }
     for (int a = 0; a < sim->dim && !sphere; a++)
-        hi[a] = lattice_count(s.min[a], s.max[a] + (a == 1 ? fabs(s.wave_amplitude) : 0), l0);
+        hi[a] = mf_lattice_count(s.min[a], s.max[a] + (a == 1 ? fabs(s.wave_amplitude) : 0), l0);
     if (s.overwrite)
         MF_CALL(remove_fluid_inside(sim, &s, sphere));
     size_t before = sim->p->n;
@@ -349,10 +333,8 @@ static int parse_open_faces(const mf_dict *d, const char *name, bool open[3][2])
 
 static int record_wall_box(mf_sim *sim, const double *mn, const double *mx, bool open[3][2])
 {
-    mf_wall_box *grown = realloc(sim->wall_boxes, (sim->nwall_boxes + 1) * sizeof *grown);
-    if (!grown)
+    if (mf_resize(&sim->wall_boxes, sim->nwall_boxes + 1, sizeof *sim->wall_boxes))
         return MF_ERROR(MF_ERR_MEMORY, "out of memory");
-    sim->wall_boxes = grown;
     mf_wall_box *b = &sim->wall_boxes[sim->nwall_boxes++];
     memcpy(b->min, mn, sizeof b->min);
     memcpy(b->max, mx, sizeof b->max);
@@ -369,7 +351,7 @@ static int add_wall_box(mf_sim *sim, const char *name, const mf_dict *d, mf_dict
     wall_settings s;
     mf_dict *out = resolved ? mf_dict_set_subdict(resolved, name) : NULL;
     MF_CALL(mf_params_apply(wall_params, 5, d, wall_extra, &s, out));
-    MF_CALL(check_box("wall", name, d, s.min, s.max, sim->dim));
+    MF_CALL(mf_lattice_check_box("wall", name, d, s.min, s.max, sim->dim));
     bool open[3][2];
     MF_CALL(parse_open_faces(d, name, open));
     MF_CALL(record_wall_box(sim, s.min, s.max, open));
@@ -377,7 +359,7 @@ static int add_wall_box(mf_sim *sim, const char *name, const mf_dict *d, mf_dict
     const long layers = s.wall_layers + s.dummy_layers;
     long lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1}, n[3] = {1, 1, 1};
     for (int a = 0; a < sim->dim; a++) {
-        long h = lattice_count(s.min[a], s.max[a], l0);
+        long h = mf_lattice_count(s.min[a], s.max[a], l0);
         n[a] = h;
         lo[a] = open[a][0] ? 0 : -layers;
         hi[a] = open[a][1] ? h : h + layers;

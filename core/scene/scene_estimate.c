@@ -9,11 +9,12 @@
 #include "mf_error.h"
 #include "mf_scene.h"
 #include "mf_trimesh.h"
+#include "scene_lattice.h"
 
-/* Lattice points in [a, b] along one axis (scene.c lattice_count). */
+/* Lattice points in [a, b] along one axis, as the builders place them. */
 static double span(double a, double b, double l0)
 {
-    double n = floor((b - a) / l0 + 1e-9);
+    double n = mf_lattice_span(a, b, l0);
     return n > 0 ? n : 0;
 }
 

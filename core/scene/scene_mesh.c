@@ -13,8 +13,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_alloc.h"
 #include "mf_emitter.h"
 #include "mf_error.h"
+#include "mf_hashmap.h"
 #include "mf_params.h"
 #include "mf_scene.h"
 #include "mf_trimesh.h"
@@ -34,91 +36,17 @@
  * far too fine). */
 #define MAX_MESH_PARTICLES 2e9
 
-/* ---- a hash map from packed lattice keys to entry indices ------------------- */
+/* ---- lattice maps: packed lattice keys to entry indices (mf_hashmap.h) ------ */
 
 typedef struct lmap {
-    size_t cap, n;    /* cap: a power of two */
-    uint64_t *key;    /* UINT64_MAX: empty */
-    uint32_t *val;
+    mf_hashmap h;
+    size_t n;
 } lmap;
 
 static void lmap_free(lmap *m)
 {
-    free(m->key);
-    free(m->val);
-    memset(m, 0, sizeof *m);
-}
-
-static inline size_t lmap_hash(uint64_t k, size_t cap)
-{
-    k ^= k >> 33;
-    k *= 0xff51afd7ed558ccdULL;
-    k ^= k >> 33;
-    return (size_t)k & (cap - 1);
-}
-
-static int lmap_grow(lmap *m)
-{
-    size_t cap = m->cap ? 2 * m->cap : 1024;
-    uint64_t *key = malloc(cap * sizeof *key);
-    uint32_t *val = malloc(cap * sizeof *val);
-    if (!key || !val) {
-        free(key);
-        free(val);
-        return MF_ERROR(MF_ERR_MEMORY, "out of memory for a lattice map of %zu points", cap);
-    }
-    memset(key, 0xff, cap * sizeof *key);
-    for (size_t s = 0; s < m->cap; s++) {
-        if (m->key[s] == UINT64_MAX)
-            continue;
-        size_t h = lmap_hash(m->key[s], cap);
-        while (key[h] != UINT64_MAX)
-            h = (h + 1) & (cap - 1);
-        key[h] = m->key[s];
-        val[h] = m->val[s];
-    }
-    free(m->key);
-    free(m->val);
-    m->key = key;
-    m->val = val;
-    m->cap = cap;
-    return 0;
-}
-
-/* The slot of key, or SIZE_MAX. */
-static inline size_t lmap_find(const lmap *m, uint64_t key)
-{
-    if (!m->cap)
-        return SIZE_MAX;
-    size_t h = lmap_hash(key, m->cap);
-    while (m->key[h] != UINT64_MAX) {
-        if (m->key[h] == key)
-            return h;
-        h = (h + 1) & (m->cap - 1);
-    }
-    return SIZE_MAX;
-}
-
-/* Insert key with value val if absent; *slot receives its slot. */
-static int lmap_insert(lmap *m, uint64_t key, uint32_t val, size_t *slot, bool *added)
-{
-    if (2 * (m->n + 1) > m->cap)
-        MF_CALL(lmap_grow(m));
-    size_t h = lmap_hash(key, m->cap);
-    while (m->key[h] != UINT64_MAX) {
-        if (m->key[h] == key) {
-            *slot = h;
-            *added = false;
-            return 0;
-        }
-        h = (h + 1) & (m->cap - 1);
-    }
-    m->key[h] = key;
-    m->val[h] = val;
-    m->n++;
-    *slot = h;
-    *added = true;
-    return 0;
+    mf_hashmap_free(&m->h);
+    m->n = 0;
 }
 
 /* ---- the lattice ----------------------------------------------------------- */
@@ -205,9 +133,9 @@ static int band_push(band *b, uint64_t key, double d2, int side)
     if (b->n >= UINT32_MAX)
         return MF_ERROR(MF_ERR_MEMORY, "more than %u lattice points near one surface",
                         UINT32_MAX);
-    MF_CALL(lmap_insert(&b->map, key, (uint32_t)b->n, &slot, &added));
+    MF_CALL(mf_hashmap_insert(&b->map.h, &b->map.n, key, (uint32_t)b->n, &slot, &added));
     if (!added) {
-        uint32_t e = b->map.val[slot];
+        uint32_t e = b->map.h.val[slot];
         if (d2 < b->d2[e]) {
             b->d2[e] = d2;
             b->side[e] = (int8_t)side;
@@ -216,13 +144,8 @@ static int band_push(band *b, uint64_t key, double d2, int side)
     }
     if (b->n == b->cap) {
         size_t cap = b->cap ? 2 * b->cap : 1024;
-        uint64_t *k = realloc(b->key, cap * sizeof *k);
-        if (k) b->key = k;
-        double *d = realloc(b->d2, cap * sizeof *d);
-        if (d) b->d2 = d;
-        int8_t *s = realloc(b->side, cap * sizeof *s);
-        if (s) b->side = s;
-        if (!k || !d || !s)
+        if (mf_resize(&b->key, cap, sizeof *b->key) || mf_resize(&b->d2, cap, sizeof *b->d2) ||
+            mf_resize(&b->side, cap, sizeof *b->side))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu lattice points near a surface",
                             cap);
         b->cap = cap;
@@ -697,10 +620,11 @@ static int place_fixed(mf_scene_meshes *sm, mf_sim *sim, uint64_t key, int kind,
     bool added;
     if (sim->p->n >= UINT32_MAX)
         return MF_ERROR(MF_ERR_MEMORY, "too many particles for the mesh lattice map");
-    MF_CALL(lmap_insert(&sm->placed, key, (uint32_t)sim->p->n, &slot, &added));
+    MF_CALL(mf_hashmap_insert(&sm->placed.h, &sm->placed.n, key, (uint32_t)sim->p->n, &slot,
+                              &added));
     if (!added) {
         /* Two meshes meet here: the point is a wall if either says so. */
-        uint32_t i = sm->placed.val[slot];
+        uint32_t i = sm->placed.h.val[slot];
         if (kind == MF_WALL && sim->p->kind[i] == MF_DUMMY) {
             sim->p->kind[i] = MF_WALL;
             (*nwall)++;
@@ -767,14 +691,14 @@ static bool touches_fluid(const side_rule *r, const band *b, uint64_t key, int d
                 if (!dx && !dy && !dz)
                     continue;
                 long n[3] = {idx[0] + dx, idx[1] + dy, idx[2] + dz};
-                size_t slot = lmap_find(&b->map, lat_key(n));
+                size_t slot = mf_hashmap_find(&b->map.h, lat_key(n));
                 if (slot == SIZE_MAX) {
                     if (r->mode == SIDE_BOTH)
                         return true;
                     continue;
                 }
                 double depth;
-                if (!solid_depth(r, b, b->map.val[slot], &depth))
+                if (!solid_depth(r, b, b->map.h.val[slot], &depth))
                     return true;
             }
     return false;
@@ -946,13 +870,11 @@ static int fill_points(const mesh_item *it, const lattice *L, int out_sign, cons
                     continue;
                 if (ncr == capcr) {
                     size_t cap = capcr ? 2 * capcr : 1024;
-                    crossing *g = realloc(cr, cap * sizeof *g);
-                    if (!g) {
+                    if (mf_resize(&cr, cap, sizeof *cr)) {
                         free(cr);
                         return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu ray crossings",
                                         cap);
                     }
-                    cr = g;
                     capcr = cap;
                 }
                 double at = (w[0] * v[0][ax] + w[1] * v[1][ax] + w[2] * v[2][ax]) / area2;
@@ -983,19 +905,17 @@ static int fill_points(const mesh_item *it, const lattice *L, int out_sign, cons
                 continue;
             for (idx[ax] = a0; idx[ax] <= a1; idx[ax]++) {
                 uint64_t key = lat_key(idx);
-                size_t slot = lmap_find(&b->map, key);
-                if (slot != SIZE_MAX && out_sign * b->side[b->map.val[slot]] >= 0)
+                size_t slot = mf_hashmap_find(&b->map.h, key);
+                if (slot != SIZE_MAX && out_sign * b->side[b->map.h.val[slot]] >= 0)
                     continue; /* on the surface or outside by the walls' own reckoning */
                 if (nkeys == capk) {
                     size_t cap = capk ? 2 * capk : 4096;
-                    uint64_t *g = realloc(keys, cap * sizeof *g);
-                    if (!g) {
+                    if (mf_resize(&keys, cap, sizeof *keys)) {
                         free(keys);
                         free(cr);
                         return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu fluid points",
                                         cap);
                     }
-                    keys = g;
                     capk = cap;
                 }
                 keys[nkeys++] = key;

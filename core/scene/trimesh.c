@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_alloc.h"
 #include "mf_error.h"
 #include "mf_trimesh.h"
 #include "trimesh_internal.h"
@@ -33,18 +34,14 @@ int mf_trimesh_reserve(mf_trimesh *m, size_t nverts, size_t ntris)
                         m->name, nverts, ntris);
     if (nverts > m->cap_verts) {
         size_t cap = nverts > 2 * m->cap_verts ? nverts : 2 * m->cap_verts;
-        double *xyz = realloc(m->xyz, 3 * cap * sizeof *xyz);
-        if (!xyz)
+        if (mf_resize(&m->xyz, 3 * cap, sizeof *m->xyz))
             return MF_ERROR(MF_ERR_MEMORY, "%s: out of memory for %zu vertices", m->name, cap);
-        m->xyz = xyz;
         m->cap_verts = cap;
     }
     if (ntris > m->cap_tris) {
         size_t cap = ntris > 2 * m->cap_tris ? ntris : 2 * m->cap_tris;
-        int32_t *tri = realloc(m->tri, 3 * cap * sizeof *tri);
-        if (!tri)
+        if (mf_resize(&m->tri, 3 * cap, sizeof *m->tri))
             return MF_ERROR(MF_ERR_MEMORY, "%s: out of memory for %zu triangles", m->name, cap);
-        m->tri = tri;
         m->cap_tris = cap;
     }
     return 0;

@@ -22,6 +22,7 @@
 #include "mf_app.h"
 #include "mf_dictio.h"
 #include "mf_error.h"
+#include "mf_fs.h"
 #include "mf_hdf5.h"
 #include "mf_post.h"
 #include "mf_runs.h"
@@ -144,21 +145,14 @@ static int replay_function(replay *r, const char *name, const mf_dict *fd, const
     return 0;
 }
 
-static int make_dir(const char *path)
-{
-    if (mkdir(path, 0777) != 0 && errno != EEXIST)
-        return MF_ERROR(MF_ERR_IO, "%s: cannot create (%s)", path, strerror(errno));
-    return 0;
-}
-
 static int replay_metric(replay *r, const char *name)
 {
     mf_app *app = r->app;
     char out_dir[4400], note[256];
     snprintf(out_dir, sizeof out_dir, "%s/postProcessing", app->cs.dir);
-    MF_CALL(make_dir(out_dir));
+    MF_CALL(mf_mkdir(out_dir));
     snprintf(out_dir, sizeof out_dir, "%s/postProcessing/%s", app->cs.dir, name);
-    MF_CALL(make_dir(out_dir));
+    MF_CALL(mf_mkdir(out_dir));
     double error = 0;
     mf_run_status_note(app->cs.dir, note, sizeof note);
     MF_CALL(mf_metric_evaluate(app->cs.dir, name, r->idx, r->n, out_dir, &error, NULL));

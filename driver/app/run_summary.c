@@ -7,6 +7,7 @@
 
 #include "mf_app.h"
 #include "mf_error.h"
+#include "mf_fs.h"
 
 /* "unstable (energy) at time ..." -> "energy"; other failures -> "" */
 static void criterion_of(const char *message, char *out, size_t len)
@@ -27,8 +28,7 @@ int mf_write_run_summary(const mf_app *app, int status)
 {
     char dir[4200], path[4300], tmp[4400], criterion[64];
     snprintf(dir, sizeof dir, "%s/output", app->cs.dir);
-    if (mkdir(dir, 0777) != 0 && errno != EEXIST)
-        return MF_ERROR(MF_ERR_IO, "%s: cannot create (%s)", dir, strerror(errno));
+    MF_CALL(mf_mkdir(dir));
     snprintf(path, sizeof path, "%s/runSummary", dir);
     snprintf(tmp, sizeof tmp, "%s.tmp", path);
     const char *message = status ? mf_error_message() : "";

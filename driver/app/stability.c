@@ -28,6 +28,7 @@
 
 #include "mf_dictio.h"
 #include "mf_error.h"
+#include "mf_fs.h"
 #include "mf_app.h"
 #include "mf_post.h"
 #include "mf_report.h"
@@ -212,10 +213,7 @@ int mf_cmd_stability(const mf_options *o)
     FILE *csv = NULL;
     if (rc == 0) {
         snprintf(path, sizeof path, "%s/stability", case_dir);
-        char cmd[4500];
-        snprintf(cmd, sizeof cmd, "mkdir -p '%s'", path);
-        if (system(cmd) != 0)
-            rc = MF_ERROR(MF_ERR_IO, "%s: cannot create", path);
+        rc = mf_mkdir_p(path);
         snprintf(path, sizeof path, "%s/stability/stability.csv", case_dir);
         csv = rc == 0 ? fopen(path, "w") : NULL;
         if (rc == 0 && !csv)

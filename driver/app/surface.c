@@ -24,6 +24,7 @@
 #include "mf_app.h"
 #include "mf_dictio.h"
 #include "mf_error.h"
+#include "mf_fs.h"
 #include "mf_hdf5.h"
 #include "mf_mesh_writer.h"
 #include "mf_post.h"
@@ -119,13 +120,6 @@ static int write_resolved(const char *dir, const mf_dict *resolved)
     return rc;
 }
 
-static int make_dir(const char *path)
-{
-    if (mkdir(path, 0777) != 0 && errno != EEXIST)
-        return MF_ERROR(MF_ERR_IO, "%s: cannot create (%s)", path, strerror(errno));
-    return 0;
-}
-
 static int run_surface(const surface_opts *o, mf_registry *reg, mf_log *log)
 {
     const char *cd = o->case_dir;
@@ -165,10 +159,10 @@ static int run_surface(const surface_opts *o, mf_registry *reg, mf_log *log)
     }
     snprintf(out_dir, sizeof out_dir, "%s/postProcessing", cd);
     if (rc == 0)
-        rc = make_dir(out_dir);
+        rc = mf_mkdir(out_dir);
     snprintf(out_dir, sizeof out_dir, "%s/postProcessing/surface", cd);
     if (rc == 0)
-        rc = make_dir(out_dir);
+        rc = mf_mkdir(out_dir);
     if (rc == 0)
         rc = write_resolved(out_dir, resolved);
     const mf_surface_ops *ops = rc == 0 ? (const mf_surface_ops *)m.info : NULL;

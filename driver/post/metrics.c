@@ -9,6 +9,7 @@
 extern const mf_metric mf_metric_scalar_advection; /* metric_scalar.c */
 extern const mf_metric mf_metric_volume_flux;      /* metric_scalar.c */
 extern const mf_metric mf_metric_poiseuille;       /* metric_poiseuille.c */
+extern const mf_metric mf_metric_resting_tank;     /* metric_resting_tank.c */
 /* metric_droplet.c: the multi-fluid cases */
 extern const mf_metric mf_metric_laplace, mf_metric_oscillation, mf_metric_layering,
     mf_metric_rayleigh_taylor, mf_metric_fluid_surge_front;
@@ -24,6 +25,7 @@ const mf_metric *const mf_metrics[] = {
     &mf_metric_rayleigh_taylor,
     &mf_metric_fluid_surge_front,
     &mf_metric_poiseuille,
+    &mf_metric_resting_tank,
 };
 const size_t mf_nmetrics = sizeof mf_metrics / sizeof mf_metrics[0];
 

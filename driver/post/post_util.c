@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_alloc.h"
 #include "mf_error.h"
 #include "mf_post.h"
 
@@ -48,10 +49,7 @@ int mf_read_csv2(const char *path, double **a, double **b, size_t *n)
         }
         if (*n == cap) {
             cap *= 2;
-            double *ga = realloc(*a, cap * sizeof **a), *gb = realloc(*b, cap * sizeof **b);
-            if (ga) *a = ga;
-            if (gb) *b = gb;
-            if (!ga || !gb)
+            if (mf_resize(a, cap, sizeof **a) || mf_resize(b, cap, sizeof **b))
                 break;
         }
         (*a)[*n] = x;

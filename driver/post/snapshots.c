@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_alloc.h"
 #include "mf_error.h"
 #include "mf_hdf5.h"
 #include "mf_post.h"
@@ -34,12 +35,10 @@ int mf_list_snapshots(const char *case_dir, int **indices, size_t *n)
             continue;
         if (*n == cap) {
             cap = cap ? 2 * cap : 64;
-            int *grown = realloc(*indices, cap * sizeof *grown);
-            if (!grown) {
+            if (mf_resize(indices, cap, sizeof **indices)) {
                 closedir(d);
                 return MF_ERROR(MF_ERR_MEMORY, "out of memory");
             }
-            *indices = grown;
         }
         (*indices)[(*n)++] = idx;
     }

@@ -87,13 +87,13 @@ static int fo_write(void *data, const mf_sim *sim)
         d->next_index++; /* frames keep the snapshots' numbers */
         return 0;
     }
-    double t0 = ls_seconds();
+    double t0 = mf_wall_seconds();
     MF_CALL(ops->reconstruct(d->m.data, sim, &d->mesh));
     MF_CALL(mf_mesh_write_frame(d->dir, "surface", d->next_index, &d->mesh, d->s.write_ply,
                                 d->s.write_obj));
     mf_log_printf(sim->log, MF_LOG_NORMAL,
                   "surface: %s/surface_%06d (%zu triangles, %s) in %.2f s\n", d->dir,
-                  d->next_index, d->mesh.ntris, d->s.method, ls_seconds() - t0);
+                  d->next_index, d->mesh.ntris, d->s.method, mf_wall_seconds() - t0);
     d->next_index++;
     return 0;
 }

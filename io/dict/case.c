@@ -10,6 +10,7 @@
 
 #include "mf_dictio.h"
 #include "mf_error.h"
+#include "mf_fs.h"
 #include "mf_params.h"
 
 static const char *const write_controls[] = {"adjustableRunTime", "timeStep", NULL};
@@ -221,8 +222,7 @@ int mf_case_write_resolved(const mf_case *c)
 {
     char dir[4200], path[4300], tmp[4400];
     snprintf(dir, sizeof dir, "%s/output", c->dir);
-    if (mkdir(dir, 0777) != 0 && errno != EEXIST)
-        return MF_ERROR(MF_ERR_IO, "%s: cannot create (%s)", dir, strerror(errno));
+    MF_CALL(mf_mkdir(dir));
     snprintf(path, sizeof path, "%s/resolvedParameters", dir);
     snprintf(tmp, sizeof tmp, "%s.tmp", path);
     FILE *f = fopen(tmp, "w");

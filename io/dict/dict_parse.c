@@ -23,7 +23,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "mf_alloc.h"
 #include "mf_error.h"
+#include "mf_hashmap.h"
 
 /* ------------------------------------------------------------------------
  * Tokenizer
@@ -341,12 +343,10 @@ static int vec_push(vec *v, mf_value *x)
 {
     if (v->n == v->cap) {
         size_t cap = v->cap ? 2 * v->cap : 1; /* most entries hold one item */
-        mf_value **grown = realloc(v->items, cap * sizeof *grown);
-        if (!grown) {
+        if (mf_resize(&v->items, cap, sizeof *v->items)) {
             mf_value_free(x);
             return MF_ERR_MEMORY;
         }
-        v->items = grown;
         v->cap = cap;
     }
     v->items[v->n++] = x;
@@ -366,8 +366,8 @@ static void vec_free(vec *v)
  * quadratic, so each dictionary being parsed has a hash index of its keys
  * (entry position + 1 per slot; 0 is empty). */
 typedef struct key_index {
-    size_t *slots;
-    size_t cap, count;
+    mf_hashmap map; /* hash_bytes of a key -> the entry's position (a hash may repeat) */
+    size_t count;
 } key_index;
 
 static uint64_t hash_bytes(const char *s, size_t n)
@@ -382,52 +382,36 @@ static uint64_t hash_bytes(const char *s, size_t n)
 
 static mf_entry *index_find(const key_index *ix, const mf_dict *d, const char *key, size_t len)
 {
-    if (!ix->cap)
+    const mf_hashmap *m = &ix->map;
+    if (!m->cap)
         return NULL;
-    for (size_t i = hash_bytes(key, len) & (ix->cap - 1);; i = (i + 1) & (ix->cap - 1)) {
-        size_t slot = ix->slots[i];
-        if (!slot)
-            return NULL;
-        mf_entry *e = d->entries[slot - 1];
+    const uint64_t h = hash_bytes(key, len);
+    for (size_t s = mf_hashmap_home(m, h); m->val[s] != MF_HASHMAP_EMPTY;
+         s = mf_hashmap_next(m, s)) {
+        if (m->key[s] != h)
+            continue;
+        mf_entry *e = d->entries[m->val[s]];
         /* key holds no NUL, so strncmp stops at a shorter entry key */
         if (strncmp(e->key, key, len) == 0 && e->key[len] == '\0')
             return e;
     }
-}
-
-static void index_put(key_index *ix, const char *key, size_t pos)
-{
-    size_t i = hash_bytes(key, strlen(key)) & (ix->cap - 1);
-    while (ix->slots[i])
-        i = (i + 1) & (ix->cap - 1);
-    ix->slots[i] = pos + 1;
-    ix->count++;
+    return NULL;
 }
 
 static int index_add(key_index *ix, const mf_dict *d, size_t pos)
 {
-    if (2 * (ix->count + 1) > ix->cap) {
-        size_t cap = ix->cap ? 2 * ix->cap : 16;
-        size_t *slots = calloc(cap, sizeof *slots);
-        if (!slots)
-            return MF_ERR_MEMORY;
-        size_t *old = ix->slots, old_cap = ix->cap;
-        ix->slots = slots;
-        ix->cap = cap;
-        ix->count = 0;
-        for (size_t k = 0; k < old_cap; k++)
-            if (old[k])
-                index_put(ix, d->entries[old[k] - 1]->key, old[k] - 1);
-        free(old);
-    }
-    index_put(ix, d->entries[pos]->key, pos);
+    if (2 * (ix->count + 1) > ix->map.cap && mf_hashmap_grow(&ix->map) != 0)
+        return MF_ERR_MEMORY;
+    const char *key = d->entries[pos]->key;
+    mf_hashmap_put_new(&ix->map, hash_bytes(key, strlen(key)), (uint32_t)pos);
+    ix->count++;
     return 0;
 }
 
 static void index_free(key_index *ix)
 {
-    free(ix->slots);
-    memset(ix, 0, sizeof *ix);
+    mf_hashmap_free(&ix->map);
+    ix->count = 0;
 }
 
 /* Set `key` in d to the items (taken from v, which is left empty). */

@@ -9,6 +9,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "mf_alloc.h"
 #include "hdf5_internal.h"
 #include "mf_error.h"
 #include "mf_hdf5.h"
@@ -77,12 +78,10 @@ int mf_h5_scan_snapshots(const char *output_dir, int **indices, size_t *n)
             continue;
         if (count == cap) {
             size_t new_cap = cap ? 2 * cap : 64;
-            int *grown = realloc(list, new_cap * sizeof *grown);
-            if (!grown) {
+            if (mf_resize(&list, new_cap, sizeof *list)) {
                 rc = MF_ERROR(MF_ERR_MEMORY, "out of memory listing %s", output_dir);
                 break;
             }
-            list = grown;
             cap = new_cap;
         }
         list[count++] = index;

@@ -11,8 +11,10 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "mf_alloc.h"
 #include "hdf5_internal.h"
 #include "mf_error.h"
+#include "mf_fs.h"
 #include "mf_hdf5.h"
 
 typedef struct hdf5_settings {
@@ -33,18 +35,6 @@ typedef struct hdf5_writer {
     int *written;         /* indices this writer wrote, oldest first (purgeWrite) */
     size_t nwritten, capwritten;
 } hdf5_writer;
-
-static int make_output_dir(const char *dir)
-{
-    if (mkdir(dir, 0777) == 0)
-        return 0;
-    if (errno != EEXIST)
-        return MF_ERROR(MF_ERR_IO, "cannot create %s: %s", dir, strerror(errno));
-    struct stat st;
-    if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode))
-        return MF_ERROR(MF_ERR_IO, "%s exists but is not a folder", dir);
-    return 0;
-}
 
 static int hdf5_create(const void *settings, const char *case_dir, void **data)
 {
@@ -69,7 +59,7 @@ static int hdf5_create(const void *settings, const char *case_dir, void **data)
     }
     memcpy(w->case_dir, case_dir, strlen(case_dir) + 1);
     MF_CALL_GOTO(rc, mf_h5_output_dir(case_dir, w->output_dir, sizeof w->output_dir), fail);
-    MF_CALL_GOTO(rc, make_output_dir(w->output_dir), fail);
+    MF_CALL_GOTO(rc, mf_mkdir(w->output_dir), fail);
 
     int *indices;
     size_t n;
@@ -96,10 +86,8 @@ static int hdf5_write(void *data, const mf_sim *sim, const mf_dict *params)
     int index = w->next_index++;
     if (w->nwritten == w->capwritten) {
         size_t cap = w->capwritten ? 2 * w->capwritten : 64;
-        int *grown = realloc(w->written, cap * sizeof *grown);
-        if (!grown)
+        if (mf_resize(&w->written, cap, sizeof *w->written))
             return MF_ERROR(MF_ERR_MEMORY, "hdf5 writer: out of memory");
-        w->written = grown;
         w->capwritten = cap;
     }
     w->written[w->nwritten++] = index;

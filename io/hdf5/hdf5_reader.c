@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_alloc.h"
 #include "hdf5_internal.h"
 #include "mf_error.h"
 #include "mf_hdf5.h"
@@ -132,10 +133,8 @@ static int grow_buffer(snap_reader *r, size_t bytes, const char *what)
 {
     if (bytes <= r->buf_size)
         return 0;
-    void *grown = realloc(r->buf, bytes);
-    if (!grown)
+    if (mf_resize(&r->buf, bytes, 1))
         return MF_ERROR(MF_ERR_MEMORY, "%s: out of memory (%zu bytes)", what, bytes);
-    r->buf = grown;
     r->buf_size = bytes;
     return 0;
 }

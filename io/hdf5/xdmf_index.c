@@ -21,6 +21,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_alloc.h"
 #include "hdf5_internal.h"
 #include "mf_error.h"
 #include "mf_hdf5.h"
@@ -155,12 +156,10 @@ int mf_xdmf_index_add(mf_xdmf_index *x, mf_xdmf_snap *s)
     }
     if (x->n == x->cap) {
         size_t cap = x->cap ? 2 * x->cap : 16;
-        mf_xdmf_snap *grown = realloc(x->snap, cap * sizeof *grown);
-        if (!grown) {
+        if (mf_resize(&x->snap, cap, sizeof *x->snap)) {
             snap_free(s);
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for the XDMF index");
         }
-        x->snap = grown;
         x->cap = cap;
     }
     memmove(&x->snap[at + 1], &x->snap[at], (x->n - at) * sizeof *x->snap);

@@ -14,7 +14,9 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "mf_alloc.h"
 #include "mf_error.h"
+#include "mf_fs.h"
 #include "mf_mesh_writer.h"
 #include "mf_timetext.h"
 
@@ -52,22 +54,6 @@ static float get_f32le(const uint8_t *p)
     float f;
     memcpy(&f, &v, 4);
     return f;
-}
-
-static int make_dirs(const char *path)
-{
-    char buf[PATH_MAX_LEN];
-    snprintf(buf, sizeof buf, "%s", path);
-    for (char *s = buf + 1; *s; s++)
-        if (*s == '/') {
-            *s = '\0';
-            if (mkdir(buf, 0777) != 0 && errno != EEXIST)
-                return MF_ERROR(MF_ERR_IO, "%s: cannot create (%s)", buf, strerror(errno));
-            *s = '/';
-        }
-    if (mkdir(buf, 0777) != 0 && errno != EEXIST)
-        return MF_ERROR(MF_ERR_IO, "%s: cannot create (%s)", buf, strerror(errno));
-    return 0;
 }
 
 /* Finish a file written under "<path>.tmp": close, check, rename. */
@@ -371,12 +357,10 @@ static int scan_frames(const char *dir, const char *prefix, frame **out, size_t 
             continue;
         if (*n == cap) {
             cap = cap ? 2 * cap : 64;
-            frame *g = realloc(*out, cap * sizeof *g);
-            if (!g) {
+            if (mf_resize(out, cap, sizeof **out)) {
                 rc = MF_ERROR(MF_ERR_MEMORY, "out of memory listing %s", dir);
                 break;
             }
-            *out = g;
         }
         (*out)[*n].index = idx;
         (*n)++;
@@ -473,7 +457,7 @@ int mf_mesh_write_xdmf_index(const char *dir, const char *prefix)
 int mf_mesh_write_frame(const char *dir, const char *prefix, int index, const mf_mesh *m,
                         bool ply, bool obj)
 {
-    MF_CALL(make_dirs(dir));
+    MF_CALL(mf_mkdir_p(dir));
     char path[PATH_MAX_LEN];
     if (ply) {
         snprintf(path, sizeof path, "%s/%s_%06d.ply", dir, prefix, index);

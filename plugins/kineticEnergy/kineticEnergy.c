@@ -15,6 +15,7 @@
 #include <sys/stat.h>
 
 #include "mf_error.h"
+#include "mf_fs.h"
 #include "mf_modules.h"
 
 typedef struct ke_settings {
@@ -31,26 +32,10 @@ static const mf_param ke_params[] = {
      "record every N steps"},
 };
 
-static int make_dirs(const char *path)
-{
-    char buf[4400];
-    snprintf(buf, sizeof buf, "%s", path);
-    for (char *s = buf + 1; *s; s++)
-        if (*s == '/') {
-            *s = '\0';
-            if (mkdir(buf, 0777) != 0 && errno != EEXIST)
-                return MF_ERROR(MF_ERR_IO, "%s: cannot create (%s)", buf, strerror(errno));
-            *s = '/';
-        }
-    if (mkdir(buf, 0777) != 0 && errno != EEXIST)
-        return MF_ERROR(MF_ERR_IO, "%s: cannot create (%s)", buf, strerror(errno));
-    return 0;
-}
-
 static int ke_create(const void *settings, const mf_sim *sim, const char *out_dir, void **data)
 {
     (void)sim;
-    MF_CALL(make_dirs(out_dir));
+    MF_CALL(mf_mkdir_p(out_dir));
     ke_data *d = calloc(1, sizeof *d);
     if (!d)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory");

@@ -9,7 +9,7 @@
 #include "mf_modules.h"
 
 extern const mf_force_ops mf_force_gravity;
-extern const mf_force_ops mf_force_surfaceTension; /* surface_tension.c, Appendix A */
+extern const mf_force_ops mf_force_surfaceTension; /* surfaceTension/, Appendix A */
 extern const mf_force_ops mf_force_drag;           /* drag.c, Appendix B */
 
 #endif

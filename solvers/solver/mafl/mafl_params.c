@@ -12,7 +12,7 @@ static const char *const references[] = {"n0", "startOfStep", "divergence", NULL
 #define MAFL_OFFSET(field) offsetof(mafl_settings, field)
 
 const mf_param mafl_params[MAFL_NPARAMS] = {
-    MPS_PARAM_ENTRIES(MAFL_MPS_OFFSET)
+    MPS_PARAM_ENTRIES(MAFL_MPS_OFFSET, "paper")
     {"reconfiguration", MF_PARAM_WORD, "fixed", MF_NO_RANGE, rules,
      MAFL_OFFSET(reconfiguration),
      "where interior points go: fixed (the Eulerian limit), fraction (of the flow), relax "

@@ -14,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_alloc.h"
 #include "mafl.h"
 #include "mf_error.h"
 
@@ -205,12 +206,10 @@ static int find_holes(mafl_data *d, const mf_sim *sim, hole **out, size_t *nout)
             continue;
         if (ncand + (size_t)per > cap) {
             cap = 2 * cap + 1024;
-            uint64_t *grown = realloc(keys, cap * sizeof *keys);
-            if (!grown) {
+            if (mf_resize(&keys, cap, sizeof *keys)) {
                 rc = MF_ERROR(MF_ERR_MEMORY, "out of memory looking for holes");
                 break;
             }
-            keys = grown;
         }
         for (long oz = dim == 3 ? -1 : 0; oz <= (dim == 3 ? 1 : 0); oz++)
             for (long oy = -1; oy <= 1; oy++)
@@ -242,13 +241,11 @@ static int find_holes(mafl_data *d, const mf_sim *sim, hole **out, size_t *nout)
             space_from_nearest(p, nearest, l0, x);
         if (nholes == hcap) {
             hcap = 2 * hcap + 64;
-            hole *grown = realloc(holes, hcap * sizeof *holes);
-            if (!grown) {
+            if (mf_resize(&holes, hcap, sizeof *holes)) {
                 free(holes);
                 free(keys);
                 return MF_ERROR(MF_ERR_MEMORY, "out of memory for new points");
             }
-            holes = grown;
         }
         memcpy(holes[nholes].x, x, sizeof x);
         holes[nholes++].closest = closest;

@@ -33,7 +33,21 @@ typedef struct mps_settings {
     double compressibility;   /* 1/Pa; adds rho c / dt^2 to the diagonal (0: off) */
     bool clip_negative_pressure;
     bool gradient_pmin;       /* eq. 5 with p_min (Koshizuka et al. 1998) */
-    bool collision;           /* optional collision model (off: the paper uses none) */
+    /* The scheme (mps_scheme.c): a named set of the five choices below,
+     * each of which a case may set apart ("scheme": the scheme's). */
+    const char *scheme;       /* paper | robust */
+    const char *source;       /* PPE source: density | mixed | higherOrder | errorCompensating */
+    const char *gradient;     /* pressure gradient: paper | corrected | leastSquares */
+    const char *laplacian;    /* paper | higherOrder | leastSquares */
+    const char *shifting;     /* none | fickian */
+    const char *surface_detection; /* numberDensity | asymmetry */
+    const char *collision_choice;  /* scheme | yes | no: the collision model */
+    double density_factor;    /* mixed source: gamma of the density term */
+    double shift_coefficient; /* fickian shifting: A of dr = -A l0^2 grad C */
+    double shift_max;         /* largest shift a step, in l0 */
+    double asymmetry;         /* asymmetry test: fraction of a flat surface's */
+    bool retry_source;        /* a retry keeps the source's density terms (mps_step.c) */
+    bool collision;           /* the collision model (resolved from collision_choice) */
     double collision_distance; /* in l0 */
     bool collision_after_correction; /* a second collision pass after eqs. 15-17 */
     double restitution;
@@ -46,8 +60,31 @@ typedef struct mps_settings {
 /* Pair averages: mf_inv_rho_pair, mf_mu_pair (mf_kernel.h); mps_data's
  * rho_average and mu_average are mf_average values. */
 
+/* The scheme's choices, resolved from the settings (mps_scheme.c). */
+typedef enum {
+    MPS_SOURCE_DENSITY,            /* eq. 14: relaxation (rho/dt^2)(n* - n0)/n0 */
+    MPS_SOURCE_MIXED,              /* Tanaka & Masunaga 2010 */
+    MPS_SOURCE_HIGHER_ORDER,       /* Khayyer & Gotoh 2009 (HS) */
+    MPS_SOURCE_ERROR_COMPENSATING  /* Khayyer & Gotoh 2011 (HS + ECS) */
+} mps_source_kind;
+typedef enum { MPS_GRADIENT_PAPER, MPS_GRADIENT_CORRECTED, MPS_GRADIENT_LEAST_SQUARES } mps_gradient_kind;
+typedef enum { MPS_LAPLACIAN_PAPER, MPS_LAPLACIAN_HIGHER_ORDER, MPS_LAPLACIAN_LEAST_SQUARES } mps_laplacian_kind;
+typedef enum { MPS_SHIFT_NONE, MPS_SHIFT_FICKIAN } mps_shift_kind;
+typedef enum { MPS_DETECT_NUMBER_DENSITY, MPS_DETECT_ASYMMETRY } mps_detection_kind;
+
+typedef struct mps_scheme {
+    const char *name;
+    mps_source_kind source;
+    mps_gradient_kind gradient;
+    mps_laplacian_kind laplacian;
+    mps_shift_kind shifting;
+    mps_detection_kind detection;
+    bool collision;
+} mps_scheme;
+
 typedef struct mps_data {
     mps_settings s;
+    mps_scheme sc;                 /* the resolved choices of s */
     mf_kernel k_nd, k_grad, k_lap; /* one kernel per operator radius */
     /* Neighbour requests (sim->neighbours), all in the order of cells of the
      * largest radius: that radius, each operator's, and the collision's. */
@@ -69,6 +106,20 @@ typedef struct mps_data {
     size_t cap_rows, cap_nnz;
     int64_t *slot;     /* PPE row -> its name for the pressure module (mf_rows) */
     size_t cap_slot;
+    /* The scheme's work arrays (mps_source.c, mps_shift.c), NULL where the
+     * scheme does not use them; one entry per particle unless said. */
+    double *n_start;   /* n at r^n (mixed, errorCompensating) */
+    double *rate_start; /* Dn/Dt at r^n, u^n (errorCompensating) */
+    double *src;       /* the PPE source / rho of the unknowns (NULL: eq. 14 as printed) */
+    double *work;      /* 15n: scratch (divergence, minimum, asymmetry, shifting) */
+    uint8_t *flag_work; /* n: scratch (LSMPS fallbacks, the surface band) */
+    size_t cap_scheme;
+    double density_scale;      /* the density terms' factor this step (retries, mps_source.c) */
+    long attempt_step;         /* the step, time and dt of the first attempt at this step */
+    double attempt_time, attempt_dt;
+    long shifted;              /* particles shifted in the last step */
+    double shift_largest;      /* their largest shift, in l0 */
+    long ls_fallbacks;         /* LSMPS rows that fell back to eq. 5/7, all steps */
     /* Last solve, for the log and for benchmarks. */
     mf_solve_report last;
     long ppe_rows;
@@ -112,16 +163,23 @@ typedef struct mps_data {
 enum { MPS_FLAG_SURFACE = 1 }; /* bits of the Flags field */
 
 extern const mf_solver_ops mf_solver_MPS;
-#define MPS_NPARAMS 16 /* checked against the table in mps_params.c */
+#define MPS_NPARAMS 27 /* checked against the table in mps_params.c */
 extern const mf_param mps_params[MPS_NPARAMS];
 extern const char *const mps_viscosity_choices[]; /* explicit, implicit */
+/* mps_scheme.c */
+extern const char *const mps_scheme_choices[], *const mps_source_choices[],
+    *const mps_gradient_choices[], *const mps_laplacian_choices[], *const mps_shifting_choices[],
+    *const mps_detection_choices[], *const mps_collision_choices[];
 /* The entries of that table, for a solver whose settings embed an
  * mps_settings (the multi-fluid solver): OFF(field) is the offset of the
- * embedded field in the embedding struct. One list, two tables.
+ * embedded field in the embedding struct; SCHEME the solver's default scheme
+ * (docs/incoming/schemes.md: MPS robust; MAFL and multiFluid paper, where
+ * robust was measured to lose MAFL points and to break the droplets'
+ * free-surface pressure). One list, three tables.
  * reNumberDensity 3.1 rather than Koshizuka & Oka's 2.1: on hydrostatic2D
  * the resting pressure comes out 7.5% high at the bottom with 2.1 and within
  * 1% with 3.1 (README, "Choices measured"). */
-#define MPS_PARAM_ENTRIES(OFF)                                                                  \
+#define MPS_PARAM_ENTRIES(OFF, SCHEME)                                                          \
     {"reNumberDensity", MF_PARAM_SCALAR, "3.1", 1.01, 10, NULL,                                 \
      OFF(re_number_density),                                                                    \
      "radius of the number density (source term, surface), in l0"},                             \
@@ -141,8 +199,39 @@ extern const char *const mps_viscosity_choices[]; /* explicit, implicit */
     {"gradientPmin", MF_PARAM_BOOL, "yes", MF_NO_RANGE, NULL,                                   \
      OFF(gradient_pmin),                                                                        \
      "pressure gradient with p_min of the neighbourhood (eq. 5 note)"},                         \
-    {"collision", MF_PARAM_BOOL, "no", MF_NO_RANGE, NULL, OFF(collision),                       \
-     "push apart particles closer than collisionDistance (not in the paper)"},                  \
+    {"scheme", MF_PARAM_WORD, SCHEME, MF_NO_RANGE, mps_scheme_choices, OFF(scheme),             \
+     "the scheme: the defaults of source, gradient, laplacian, shifting, surfaceDetection "      \
+     "and collision (paper: eqs. 5, 7, 14, 18 as printed)"},                                     \
+    {"source", MF_PARAM_WORD, "scheme", MF_NO_RANGE, mps_source_choices, OFF(source),          \
+     "source term of the pressure equation: density (eq. 14), mixed (Tanaka & Masunaga 2010), " \
+     "higherOrder (Khayyer & Gotoh 2009), errorCompensating (Khayyer & Gotoh 2011)"},           \
+    {"densityFactor", MF_PARAM_SCALAR, "0.2", 0, 1, NULL, OFF(density_factor),                \
+     "source mixed: weight gamma of the density-deviation term"},                              \
+    {"gradient", MF_PARAM_WORD, "scheme", MF_NO_RANGE, mps_gradient_choices, OFF(gradient),    \
+     "pressure gradient: paper (eq. 5), corrected (CMPS, Khayyer & Gotoh 2008), "               \
+     "leastSquares (LSMPS, Tamai & Koshizuka 2014)"},                                           \
+    {"laplacian", MF_PARAM_WORD, "scheme", MF_NO_RANGE, mps_laplacian_choices, OFF(laplacian), \
+     "Laplacian: paper (eq. 7), higherOrder (Khayyer & Gotoh 2010), leastSquares (LSMPS in "    \
+     "the viscous term, higherOrder in the pressure equation)"},                                \
+    {"shifting", MF_PARAM_WORD, "scheme", MF_NO_RANGE, mps_shifting_choices, OFF(shifting),    \
+     "particle shifting: none, fickian (Lind et al. 2012; tangential at the free surface)"},   \
+    {"shiftCoefficient", MF_PARAM_SCALAR, "0.05", 0, 1, NULL, OFF(shift_coefficient),          \
+     "shifting fickian: A of dr = -A l0^2 grad C"},                                             \
+    {"shiftMax", MF_PARAM_SCALAR, "0.05", 0, 0.5, NULL, OFF(shift_max),                         \
+     "shifting: largest shift of a particle in a step, in l0"},                                 \
+    {"surfaceDetection", MF_PARAM_WORD, "scheme", MF_NO_RANGE, mps_detection_choices,          \
+     OFF(surface_detection),                                                                    \
+     "free surface: numberDensity (eq. 18), asymmetry (eq. 18 and neighbour asymmetry, "        \
+     "Khayyer et al. 2009; walls under fluid stay unknowns)"},                                  \
+    {"asymmetry", MF_PARAM_SCALAR, "0.2", 0, 2, NULL, OFF(asymmetry),                          \
+     "surfaceDetection asymmetry: surface where n* < beta n0 and the asymmetry exceeds this "   \
+     "fraction of a flat surface's"},                                                           \
+    {"retrySource", MF_PARAM_BOOL, "yes", MF_NO_RANGE, NULL, OFF(retry_source),                 \
+     "when the watch retries a step with a shorter dt, keep the density terms of the source "   \
+     "(mixed, errorCompensating) at the first attempt's strength (eq. 14 stays as printed)"},    \
+    {"collision", MF_PARAM_WORD, "scheme", MF_NO_RANGE, mps_collision_choices,                 \
+     OFF(collision_choice),                                                                     \
+     "push apart particles closer than collisionDistance (yes/no; the paper uses none)"},      \
     {"collisionAfterCorrection", MF_PARAM_BOOL, "no", MF_NO_RANGE, NULL,                        \
      OFF(collision_after_correction),                                                           \
      "collide again after the pressure correction (keeps fluid out of thin walls)"},            \
@@ -196,6 +285,24 @@ int mps_pressure_phase(mps_data *d, mf_sim *sim, double dt);     /* eqs. 11-14, 
 int mps_correction_phase(mps_data *d, mf_sim *sim, double dt);   /* eqs. 15-17 */
 /* The whole Lagrangian step, as MPS-MAFL calls it. */
 int mps_lagrangian_step(mps_data *d, mf_sim *sim, double dt);
+
+/* mps_scheme.c: the scheme's choices from the settings (errors name the
+ * dictionary); the work arrays the scheme needs; its log line. */
+int mps_scheme_resolve(const mps_settings *s, int dim, mps_scheme *out);
+int mps_scheme_reserve(mps_data *d, size_t n);
+void mps_scheme_free(mps_data *d);
+void mps_scheme_log(const mps_data *d, mf_log *log);
+
+/* mps_source.c: the source term of the pressure equation. */
+/* At r^n with u^n (lists at r^n), before the explicit phase: what the
+ * source needs of the start of the step. */
+int mps_source_start(mps_data *d, mf_sim *sim);
+/* At r* with u* (lists at r*), after the surface phase: d->src of the
+ * unknowns (in_ppe), or nothing for the density source of eq. 14. */
+int mps_source_terms(mps_data *d, const mf_sim *sim, double dt);
+
+/* mps_shift.c: particle shifting after the correction (Lind et al. 2012). */
+int mps_shift(mps_data *d, mf_sim *sim);
 
 /* mps_ppe.c */
 int mps_assemble_ppe(mps_data *d, const mf_sim *sim, double dt);

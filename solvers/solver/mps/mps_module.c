@@ -2,6 +2,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_alloc.h"
 #include "mf_error.h"
 #include "mps.h"
 
@@ -109,15 +110,11 @@ int mps_reserve(mps_data *d, size_t n)
     if (n <= d->cap)
         return 0;
     size_t cap = n + n / 4 + 64;
-    d->acc = realloc(d->acc, 3 * cap * sizeof *d->acc);
-    d->grad = realloc(d->grad, 3 * cap * sizeof *d->grad);
-    d->is_fluid = realloc(d->is_fluid, cap);
-    d->in_ppe = realloc(d->in_ppe, cap);
-    d->dirichlet = realloc(d->dirichlet, cap);
-    d->not_dummy = realloc(d->not_dummy, cap);
-    d->row = realloc(d->row, cap * sizeof *d->row);
-    if (!d->acc || !d->grad || !d->is_fluid || !d->in_ppe || !d->dirichlet || !d->not_dummy ||
-        !d->row)
+    if (mf_resize(&d->acc, 3 * cap, sizeof *d->acc) ||
+        mf_resize(&d->grad, 3 * cap, sizeof *d->grad) ||
+        mf_resize(&d->is_fluid, cap, 1) || mf_resize(&d->in_ppe, cap, 1) ||
+        mf_resize(&d->dirichlet, cap, 1) || mf_resize(&d->not_dummy, cap, 1) ||
+        mf_resize(&d->row, cap, sizeof *d->row))
         return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu particles", n);
     d->cap = cap;
     return 0;
@@ -133,6 +130,10 @@ int mps_create_data(const mps_settings *s, mf_sim *sim, const mf_dict *solver_di
         return MF_ERROR(MF_ERR_MEMORY, "out of memory");
     *out = d;
     d->s = *s;
+    MF_CALL(mps_scheme_resolve(s, sim->dim, &d->sc));
+    d->s.collision = d->sc.collision;
+    d->density_scale = 1.0;
+    d->attempt_step = -1;
     MF_CALL(mf_kernel_init(&d->k_nd, sim->dim, sim->l0, s->re_number_density * sim->l0));
     MF_CALL(mf_kernel_init(&d->k_grad, sim->dim, sim->l0, s->re_gradient * sim->l0));
     MF_CALL(mf_kernel_init(&d->k_lap, sim->dim, sim->l0, s->re_laplacian * sim->l0));
@@ -163,6 +164,7 @@ int mps_create_data(const mps_settings *s, mf_sim *sim, const mf_dict *solver_di
                       "MPS kernel (%s): re = %g l0, n0 = %.6g, lambda = %.6g l0^2\n", names[k],
                       ks[k]->re / sim->l0, ks[k]->n0, ks[k]->lambda / (sim->l0 * sim->l0));
     mf_log_printf(sim->log, MF_LOG_NORMAL, "Pressure solver: %s\n", d->pressure.info->name);
+    mps_scheme_log(d, sim->log);
     return 0;
 }
 
@@ -188,6 +190,7 @@ void mps_destroy_data(mps_data *d)
     free(d->A.rowptr);
     free(d->A.col);
     free(d->A.val);
+    mps_scheme_free(d);
     free(d);
 }
 

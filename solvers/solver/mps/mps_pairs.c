@@ -3,10 +3,37 @@
  * gradient operator of core (mf_gradient_ex) with 1/rho_ij inside the sum,
  * then the update of eqs. 16-17. */
 #include <math.h>
+#include <string.h>
 
 #include "mf_error.h"
+#include "mf_lsmps.h"
 #include "mf_operators.h"
 #include "mps.h"
+
+/* The LSMPS gradient (Tamai & Koshizuka 2014) divided by rho_i, eq. 5 with
+ * the pair coefficient where the fit is singular. */
+static int least_squares(mps_data *d, const mf_sim *sim, const mf_pairs *v,
+                         const mf_gradient_opts *o, const uint8_t *imask)
+{
+    const mf_particles *p = sim->p;
+    MF_CALL(mps_scheme_reserve(d, p->n));
+    uint8_t *failed = d->flag_work;
+    memset(failed, 0, p->n);
+    size_t nfailed =
+        mf_lsmps_gradient(v, &d->k_grad, o->f, imask, d->not_dummy, d->grad, failed);
+    for (size_t i = 0; i < p->n_owned; i++) {
+        if (!imask[i] || failed[i])
+            continue;
+        const double inv_rho = d->rho ? 1.0 / d->rho[i] : o->coef;
+        for (int c = 0; c < 3; c++)
+            d->grad[3 * i + c] *= inv_rho;
+    }
+    if (nfailed) {
+        d->ls_fallbacks += (long)nfailed;
+        mf_gradient_ex(v, &d->k_grad, o, failed, d->not_dummy, d->grad);
+    }
+    return 0;
+}
 
 /* eq. 15 with 1/rho_ij inside the gradient sum (eq. 5): the same pair
  * coefficient as the PPE, so the correction is the one the PPE solved for
@@ -16,7 +43,7 @@ int mps_gradient_pairs(mps_data *d, const mf_sim *sim, const double *pressure,
 {
     mf_pairs v;
     MF_CALL(mps_pairs(d, sim, d->h_grad, &v));
-    const mf_gradient_opts o = {
+    mf_gradient_opts o = {
         .f = pressure,
         .use_min = d->s.gradient_pmin,
         .own_reference = d->own_reference,
@@ -24,7 +51,19 @@ int mps_gradient_pairs(mps_data *d, const mf_sim *sim, const double *pressure,
         .rho_average = d->rho_average,
         .coef = 1.0 / d->rho_default,
     };
-    mf_gradient_ex(&v, &d->k_grad, &o, imask ? imask : d->is_fluid, d->not_dummy, d->grad);
+    const uint8_t *im = imask ? imask : d->is_fluid;
+    if (d->sc.gradient == MPS_GRADIENT_LEAST_SQUARES)
+        return least_squares(d, sim, &v, &o, im);
+    if (d->sc.gradient == MPS_GRADIENT_CORRECTED) {
+        /* p^ of every particle the sums read (eq. 5's p_min, always) */
+        MF_CALL(mps_scheme_reserve(d, sim->p->n));
+        double *fhat = d->work;
+        mf_neighbour_min(&v, pressure, true, d->own_reference, d->not_dummy, d->not_dummy, fhat);
+        if (d->periodic)
+            mps_periodic_sync(d, sim->p, fhat, sizeof *fhat);
+        o.fhat = fhat;
+    }
+    mf_gradient_ex(&v, &d->k_grad, &o, im, d->not_dummy, d->grad);
     return 0;
 }
 

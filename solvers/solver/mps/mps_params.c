@@ -4,7 +4,7 @@
 #include "mps.h"
 
 #define MPS_OFFSET(field) offsetof(mps_settings, field)
-const mf_param mps_params[MPS_NPARAMS] = {MPS_PARAM_ENTRIES(MPS_OFFSET)};
+const mf_param mps_params[MPS_NPARAMS] = {MPS_PARAM_ENTRIES(MPS_OFFSET, "robust")};
 /* Too many entries fail to compile; too few leave a nameless entry, which
  * the registry refuses at start-up. */
 

@@ -23,6 +23,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_alloc.h"
 #include "mf_error.h"
 #include "mps.h"
 
@@ -117,10 +118,8 @@ int mps_periodic_add_images(mps_data *d, mf_sim *sim)
         count += (p->pos[3 * i] < lo) + (p->pos[3 * i] >= hi);
     if (count > pp->cap) {
         size_t cap = count + count / 4 + 64;
-        size_t *owner = realloc(pp->owner, cap * sizeof *owner);
-        if (!owner)
+        if (mf_resize(&pp->owner, cap, sizeof *pp->owner))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu periodic images", count);
-        pp->owner = owner;
         pp->cap = cap;
     }
     MF_CALL(mf_particles_reserve(p, n + count));

@@ -23,20 +23,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_alloc.h"
 #include "mf_error.h"
 #include "mf_hash.h"
 #include "mf_run.h"
 #include "mps.h"
-
-/* Grow *ptr to count elements, keeping the old block when that fails. */
-static int grow(void **ptr, size_t count, size_t elem)
-{
-    void *grown = realloc(*ptr, count * elem);
-    if (!grown)
-        return MF_ERR_MEMORY;
-    *ptr = grown;
-    return 0;
-}
 
 /* Room for rows unknowns and nnz entries; 1/16 headroom (the counts drift
  * little from step to step, and the matrix is the largest array of a run). */
@@ -44,15 +35,15 @@ static int reserve_system(mps_data *d, size_t rows, size_t nnz)
 {
     if (rows + 1 > d->cap_rows) {
         size_t cap = rows + rows / 16 + 64;
-        if (grow((void **)&d->A.rowptr, cap + 1, sizeof *d->A.rowptr) ||
-            grow((void **)&d->rhs, cap, sizeof *d->rhs) || grow((void **)&d->x, cap, sizeof *d->x))
+        if (mf_resize(&d->A.rowptr, cap + 1, sizeof *d->A.rowptr) ||
+            mf_resize(&d->rhs, cap, sizeof *d->rhs) || mf_resize(&d->x, cap, sizeof *d->x))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu pressure unknowns", rows);
         d->cap_rows = cap;
     }
     if (nnz > d->cap_nnz) {
         size_t cap = nnz + nnz / 16 + 64;
-        if (grow((void **)&d->A.col, cap, sizeof *d->A.col) ||
-            grow((void **)&d->A.val, cap, sizeof *d->A.val))
+        if (mf_resize(&d->A.col, cap, sizeof *d->A.col) ||
+            mf_resize(&d->A.val, cap, sizeof *d->A.val))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu matrix entries", nnz);
         d->cap_nnz = cap;
     }
@@ -109,6 +100,10 @@ typedef struct ppe_ctx {
     mf_rows rows;
     double c, dt, rho, n0, re;
     const double *rho_p, *pd, *n, *pressure;
+    const double *src; /* the scheme's source (mps_source.c), NULL: eq. 14 */
+    bool hl;           /* the higher-order Laplacian's weight (Khayyer & Gotoh 2010) */
+    bool walls_push;   /* wall unknowns' sources clipped at zero */
+    int dim;
     int avg;
     uint8_t *touches;
 } ppe_ctx;
@@ -121,7 +116,8 @@ typedef struct ppe_acc {
 static inline double ppe_coef(const void *ctx, const mf_pair *pr)
 {
     const ppe_ctx *c = ctx;
-    double cw = c->c * mf_weight(pr->len, c->re);
+    double cw = c->hl ? c->c * mf_weight_hl(pr->len, c->re, c->dim)
+                      : c->c * mf_weight(pr->len, c->re);
     if (c->rho_p)
         cw *= mf_inv_rho_pair(c->rho_p[pr->i], c->rho_p[pr->j], c->avg);
     return cw;
@@ -155,11 +151,13 @@ static bool ppe_row(const void *ctx, size_t i, size_t r)
     double *val = d->A.val;
     if (c->rho_p) {
         val[diag] = sum + d->s.compressibility / dt2;
-        d->rhs[r] = d->s.relaxation / dt2 * dn / c->n0;
+        d->rhs[r] = c->src ? c->src[i] : d->s.relaxation / dt2 * dn / c->n0;
     } else {
         val[diag] = sum + d->s.compressibility * c->rho / dt2;
-        d->rhs[r] = d->s.relaxation * c->rho / dt2 * dn / c->n0;
+        d->rhs[r] = c->src ? c->rho * c->src[i] : d->s.relaxation * c->rho / dt2 * dn / c->n0;
     }
+    if (c->walls_push && !d->is_fluid[i] && d->rhs[r] < 0)
+        d->rhs[r] = 0; /* surfaceDetection asymmetry: a wall pushes, never pulls */
     if (c->pd)
         d->rhs[r] += acc.known;
     c->touches[r] = acc.touches;
@@ -229,8 +227,20 @@ int mps_assemble_ppe(mps_data *d, const mf_sim *sim, double dt)
         .pressure = mf_particles_fd(p, d->f_pressure),
         .avg = d->rho_average,
         .touches = touches,
+        .dim = d->k_lap.dim,
+        .walls_push = d->sc.detection == MPS_DETECT_ASYMMETRY,
     };
-    int rc = mps_pairs(d, sim, d->h_lap, &c.v);
+    /* The scheme's source and Laplacian (a composing solver's per-particle
+     * density reference, MAFL's densityReference, keeps eq. 14's source). */
+    int rc = d->n_offset ? 0 : mps_source_terms(d, sim, dt);
+    if (rc == 0 && d->sc.source != MPS_SOURCE_DENSITY && !d->n_offset)
+        c.src = d->src;
+    if (d->sc.laplacian != MPS_LAPLACIAN_PAPER) { /* higherOrder, and leastSquares' PPE */
+        c.hl = true;
+        c.c = d->k_lap.hl_coef;
+    }
+    if (rc == 0)
+        rc = mps_pairs(d, sim, d->h_lap, &c.v);
     c.re = c.v.radius;
     size_t failed = SIZE_MAX;
     if (rc == 0)
@@ -320,10 +330,8 @@ static int name_rows(mps_data *d, const mf_sim *sim, mf_row_names *rows)
     const mf_particles *p = sim->p;
     if (d->A.nrows > d->cap_slot) {
         size_t cap = d->A.nrows + d->A.nrows / 4 + 64;
-        int64_t *grown = realloc(d->slot, cap * sizeof *grown);
-        if (!grown)
+        if (mf_resize(&d->slot, cap, sizeof *d->slot))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu pressure unknowns", cap);
-        d->slot = grown;
         d->cap_slot = cap;
     }
     uint64_t h = mf_hash_word(MF_HASH_START, p->n_owned);

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "mf_error.h"
+#include "mf_lsmps.h"
 #include "mf_operators.h"
 #include "mf_run.h"
 #include "mps.h"
@@ -46,6 +47,15 @@ void mps_set_masks(mps_data *d, const mf_particles *p)
     }
 }
 
+/* Is there a pair at all (the first ends the row)? */
+static inline bool any_pair(void *acc, const void *ctx, const mf_pair *pr)
+{
+    (void)ctx;
+    (void)pr;
+    *(bool *)acc = true;
+    return false;
+}
+
 /* Optional collision model (Koshizuka lab's MPS codes, mf_collision):
  * approaching pairs closer than the collision distance exchange momentum
  * with restitution e; positions follow the velocity change. */
@@ -65,6 +75,58 @@ static int collide(mps_data *d, mf_sim *sim, double dt)
     return 0;
 }
 
+/* The viscous term of eqs. 9 and 27 with the scheme's Laplacian: the
+ * higher-order one (Khayyer & Gotoh 2010), or LSMPS (Tamai & Koshizuka
+ * 2014) for one fluid, eq. 7 where its fit is singular; with a viscosity per
+ * particle leastSquares takes the higher-order form (the pair viscosity
+ * mu_ij has no least-squares counterpart here). */
+static int viscous_term(mps_data *d, mf_sim *sim)
+{
+    mf_particles *p = sim->p;
+    mf_pairs v;
+    MF_CALL(mps_pairs(d, sim, d->h_lap, &v));
+    if (d->mu) {
+        mf_laplacian_hl_mu(&v, &d->k_lap, p->vel, d->mu, d->mu_average, d->is_fluid, d->rho,
+                           d->is_fluid, d->acc);
+        return 0;
+    }
+    const double nu = sim->fluid[0].nu;
+    if (d->sc.laplacian == MPS_LAPLACIAN_HIGHER_ORDER) {
+        mf_laplacian_hl_add(&v, &d->k_lap, p->vel, nu, d->is_fluid, NULL, d->acc);
+        return 0;
+    }
+    MF_CALL(mps_scheme_reserve(d, p->n));
+    uint8_t *failed = d->flag_work;
+    memset(failed, 0, p->n);
+    size_t nfailed = mf_lsmps_laplacian_add(&v, &d->k_lap, p->vel, nu, d->is_fluid, d->not_dummy,
+                                            d->acc, failed);
+    if (nfailed) {
+        d->ls_fallbacks += (long)nfailed;
+        mf_laplacian_add(&v, &d->k_lap, p->vel, nu, failed, NULL, d->acc);
+    }
+    return 0;
+}
+
+/* A retry: the run loop (core/run/run.c) restored the particles and calls
+ * again from the same time and step with a shorter dt. The density terms of
+ * the scheme's source (mps_source.c) then keep the first attempt's
+ * strength, dt / dt_first: a density error (n - n0)/n0 corrected within one
+ * step needs a velocity of (n - n0)/n0 l / dt, which each halving would
+ * double, driving the particle-scale noise of n* harder at every retry (the
+ * 1/dt^2 of eq. 14). Eq. 14 itself (source density) is left as printed. */
+static void retry_scale(mps_data *d, const mf_sim *sim, double dt)
+{
+    if (d->s.retry_source && sim->step == d->attempt_step && sim->time == d->attempt_time &&
+        dt < d->attempt_dt) {
+        d->density_scale = dt / d->attempt_dt;
+        return;
+    }
+    d->attempt_step = sim->step;
+    d->attempt_time = sim->time;
+    d->attempt_dt = dt;
+    d->density_scale = 1.0;
+}
+
 /* eqs. 9-10: u* = u + dt (nu lap u + forces), r* = r + dt u*. With a
  * density and viscosity per particle (mps_data.mu), eq. 27: each particle's
  * own nu, pairs of unlike particles through mu_ij. */
@@ -74,10 +136,14 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
     d->attempts++;
     mf_particles *p = sim->p;
     const double nu = sim->fluid[0].nu;
+    retry_scale(d, sim, dt);
+    MF_CALL(mps_source_start(d, sim)); /* what the scheme's source needs of r^n, u^n */
     memset(d->acc, 0, 3 * p->n * sizeof *d->acc);
     MF_CALL(mf_force_accumulate(sim, d->acc));
     if (d->visc) { /* viscosity implicit: u* = (I - dt nu lap)^-1 (u + dt a), r* = r + dt u* */
         MF_CALL(mps_viscosity_implicit(d, sim, dt));
+    } else if ((d->mu || nu > 0) && d->sc.laplacian != MPS_LAPLACIAN_PAPER) {
+        MF_CALL(viscous_term(d, sim));
     } else if (d->mu || nu > 0) {
         mf_pairs v;
         MF_CALL(mps_pairs(d, sim, d->h_lap, &v));
@@ -103,6 +169,47 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
     return 0;
 }
 
+/* Free surface by eq. 18 and the asymmetry of the neighbourhood (Khayyer,
+ * Gotoh & Shao 2009, Appl. Ocean Res. 31, 111-131, section 3.3): a fluid
+ * particle with n* < beta n0 is on the free surface only where its
+ * neighbours (walls and dummies included) lie to one side, |(1/n0) sum_j
+ * r_ij/|r_ij| w_ij| above `asymmetry` times that of a flat free surface: a
+ * particle beside a wall, or inside a thin sheet between two of its faces,
+ * whose n* has dipped is not; one with n* below MPS_SPARSE n0 (spray, a
+ * chain of particles: symmetric but no bulk around it) is. A wall particle takes part as an unknown
+ * while a fluid particle is within the gradient's radius of it (a thin
+ * sheet on a floor is held up by the floor's pressure), else it is on the
+ * surface (p = 0); its source is clipped at zero (mps_ppe.c): a wall pushes
+ * and does not pull. Into d->flag_work: 1 on the surface. */
+#define MPS_SPARSE 0.8
+static int detect_by_asymmetry(mps_data *d, mf_sim *sim, const mf_pairs *vnd)
+{
+    mf_particles *p = sim->p;
+    MF_CALL(mps_scheme_reserve(d, p->n));
+    const double *n = mf_particles_fd(p, d->f_number_density);
+    double *F = d->work;
+    mf_neighbour_asymmetry(vnd, &d->k_nd, d->is_fluid, NULL, F);
+    mf_pairs vg;
+    MF_CALL(mps_pairs(d, sim, d->h_grad, &vg));
+    const double thr = d->s.asymmetry * d->k_nd.asym_flat, n0 = d->k_nd.n0;
+    uint8_t *surface = d->flag_work;
+    for (size_t i = 0; i < p->n_owned; i++) {
+        surface[i] = 0;
+        if (!d->not_dummy[i] || !(n[i] < d->s.beta * n0))
+            continue;
+        if (d->is_fluid[i]) {
+            const double *f = &F[3 * i];
+            surface[i] = n[i] < MPS_SPARSE * n0 ||
+                         sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]) > thr;
+        } else {
+            bool contact = false;
+            mf_pairs_row_r2(&vg, i, d->is_fluid, any_pair, NULL, &contact);
+            surface[i] = !contact;
+        }
+    }
+    return 0;
+}
+
 /* eq. 18: number density at r*, free surface, the PPE's unknowns. */
 int mps_surface_phase(mps_data *d, mf_sim *sim)
 {
@@ -114,8 +221,12 @@ int mps_surface_phase(mps_data *d, mf_sim *sim)
     MF_CALL(mps_pairs(d, sim, d->h_nd, &v));
     mf_number_density(&v, d->not_dummy, NULL, n);
     const double n0 = d->k_nd.n0;
+    if (d->sc.detection == MPS_DETECT_ASYMMETRY)
+        MF_CALL(detect_by_asymmetry(d, sim, &v));
     for (size_t i = 0; i < p->n_owned; i++) {
-        bool surface = d->not_dummy[i] && n[i] < d->s.beta * n0;
+        bool surface = d->sc.detection == MPS_DETECT_ASYMMETRY
+                           ? d->flag_work[i]
+                           : d->not_dummy[i] && n[i] < d->s.beta * n0;
         d->dirichlet[i] = surface;
         d->in_ppe[i] = d->not_dummy[i] && !surface;
         flags[i] = surface ? MPS_FLAG_SURFACE : 0;
@@ -155,10 +266,14 @@ int mps_correction_phase(mps_data *d, mf_sim *sim, double dt)
     double t0 = mf_wall_seconds();
     mf_particles *p = sim->p;
     const double *pr = mf_particles_fd(p, d->f_pressure);
-    if (d->rho) { /* a density per particle: 1/rho_ij in the sum */
+    if (d->rho || d->sc.gradient != MPS_GRADIENT_PAPER) {
+        /* a density per particle (1/rho_ij in the sum) or the scheme's gradient */
         MF_CALL(mps_gradient_pairs(d, sim, pr, NULL));
         mps_apply_correction(d, p, dt, NULL);
+        if (!d->rho && d->s.collision && d->s.collision_after_correction)
+            MF_CALL(collide(d, sim, dt));
         d->t_correction += mf_wall_seconds() - t0;
+        MF_CALL(mps_shift(d, sim));
         return 0;
     }
     mf_pairs v;
@@ -177,6 +292,7 @@ int mps_correction_phase(mps_data *d, mf_sim *sim, double dt)
     if (d->s.collision && d->s.collision_after_correction)
         MF_CALL(collide(d, sim, dt));
     d->t_correction += mf_wall_seconds() - t0;
+    MF_CALL(mps_shift(d, sim));
     return 0;
 }
 

@@ -24,6 +24,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_alloc.h"
 #include "mf_error.h"
 #include "mf_run.h"
 #include "mps.h"
@@ -80,36 +81,21 @@ static int reserve(mps_viscosity *v, size_t np, size_t rows, size_t nnz)
 {
     if (np > v->cap_p) {
         size_t cap = np + np / 4 + 64;
-        long *row = realloc(v->row, cap * sizeof *row);
-        if (!row)
+        if (mf_resize(&v->row, cap, sizeof *v->row))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu particles", np);
-        v->row = row;
         v->cap_p = cap;
     }
     if (rows + 1 > v->cap_rows) {
         size_t cap = rows + rows / 4 + 64;
-        size_t *rowptr = realloc(v->A.rowptr, (cap + 1) * sizeof *rowptr);
-        if (rowptr)
-            v->A.rowptr = rowptr;
-        double *b = realloc(v->b, cap * sizeof *b);
-        if (b)
-            v->b = b;
-        double *x = realloc(v->x, cap * sizeof *x);
-        if (x)
-            v->x = x;
-        if (!rowptr || !b || !x)
+        if (mf_resize(&v->A.rowptr, cap + 1, sizeof *v->A.rowptr) ||
+            mf_resize(&v->b, cap, sizeof *v->b) || mf_resize(&v->x, cap, sizeof *v->x))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu viscous unknowns", rows);
         v->cap_rows = cap;
     }
     if (nnz > v->cap_nnz) {
         size_t cap = nnz + nnz / 16 + 64;
-        int32_t *col = realloc(v->A.col, cap * sizeof *col);
-        if (col)
-            v->A.col = col;
-        double *val = realloc(v->A.val, cap * sizeof *val);
-        if (val)
-            v->A.val = val;
-        if (!col || !val)
+        if (mf_resize(&v->A.col, cap, sizeof *v->A.col) ||
+            mf_resize(&v->A.val, cap, sizeof *v->A.val))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu matrix entries", nnz);
         v->cap_nnz = cap;
     }

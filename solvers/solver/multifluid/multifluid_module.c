@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_alloc.h"
 #include "mf_error.h"
 #include "multifluid.h"
 
@@ -14,21 +15,15 @@ int multifluid_reserve(multifluid_data *d, size_t n)
     size_t cap = n + n / 4 + 64;
     double **dbl[] = {&d->rho, &d->rho_light, &d->mu, &d->p_dirichlet, &d->p_prev};
     for (size_t k = 0; k < sizeof dbl / sizeof dbl[0]; k++) {
-        double *grown = realloc(*dbl[k], cap * sizeof **dbl[k]);
-        if (!grown)
+        if (mf_resize(dbl[k], cap, sizeof **dbl[k]))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu particles", n);
-        *dbl[k] = grown;
     }
-    double *grown3 = realloc(d->grad_prev, 3 * cap * sizeof *d->grad_prev);
-    if (!grown3)
+    if (mf_resize(&d->grad_prev, 3 * cap, sizeof *d->grad_prev))
         return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu particles", n);
-    d->grad_prev = grown3;
     uint8_t **masks[] = {&d->in_all, &d->light_mask, &d->heavy_mask, &d->heavy_rows};
     for (size_t k = 0; k < sizeof masks / sizeof masks[0]; k++) {
-        uint8_t *grown = realloc(*masks[k], cap);
-        if (!grown)
+        if (mf_resize(masks[k], cap, 1))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu particles", n);
-        *masks[k] = grown;
     }
     d->cap = cap;
     return 0;

@@ -74,6 +74,7 @@ static int one_fluid_step(multifluid_data *d, mf_sim *sim, double dt)
     MF_CALL(mps_build_neighbours(m, sim, false));
     MF_CALL(multifluid_surface_pressure_phase(d, sim, dt));
     MF_CALL(multifluid_surface_correction(d, sim, dt));
+    MF_CALL(mps_shift(m, sim)); /* the scheme's particle shifting */
     return 0;
 }
 
@@ -100,11 +101,13 @@ int multifluid_step(multifluid_data *d, mf_sim *sim, double dt)
     MF_CALL(mps_build_neighbours(m, sim, false)); /* at r* */
     if (d->iterative) {
         MF_CALL(multifluid_iterative_pressure(d, sim, dt));
+        MF_CALL(mps_shift(m, sim));
         return 0;
     }
     if (d->surface_pressure) { /* p = sigma kappa on the free surface */
         MF_CALL(multifluid_surface_pressure_phase(d, sim, dt));
         MF_CALL(multifluid_surface_correction(d, sim, dt));
+        MF_CALL(mps_shift(m, sim));
         return 0;
     }
     MF_CALL(mps_pressure_phase(m, sim, dt));   /* variable-density PPE, one solve */

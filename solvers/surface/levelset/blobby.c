@@ -39,16 +39,16 @@ static int blobby_reconstruct(void *data, const mf_sim *sim, mf_mesh *out)
     ls_crossing_init(&cross);
     int32_t *nb = NULL;
     int rc = 0;
-    double t0 = ls_seconds();
+    double t0 = mf_wall_seconds();
     MF_CALL_GOTO(rc, ls_field_setup(&f, sim->p, LS_KERNEL_BLOBBY, h, l0, s->radius, s->radius, 2,
                                     -s->iso_value, false, limit, what),
                  done);
-    double t1 = ls_seconds();
+    double t1 = mf_wall_seconds();
     MF_CALL_GOTO(rc, ls_detect(&f, l0, limit, &cross), done);
-    double t2 = ls_seconds();
+    double t2 = mf_wall_seconds();
     MF_CALL_GOTO(rc, ls_bricks_neighbours(&cross.b, &nb), done);
     MF_CALL_GOTO(rc, ls_mesh_extract(&cross.b, nb, cross.F, NULL, NULL, h, out), done);
-    double t3 = ls_seconds();
+    double t3 = mf_wall_seconds();
     mf_log_printf(sim->log, MF_LOG_NORMAL,
                   "blobby: time %g, %zu fluid particles, grid spacing %g m (l0/h = %.3g): %zu "
                   "bricks crossed, mesh of %zu vertices and %zu triangles; seconds: binning "

@@ -38,6 +38,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "mf_clock.h"
+#include "mf_hashmap.h"
 #include "mf_log.h"
 #include "mf_mesh.h"
 #include "mf_modules.h"
@@ -113,9 +115,7 @@ static inline int ls_local_index(int i, int j, int k) { return i + LS_B * (j + L
 typedef struct ls_bricks {
     size_t n, cap;
     int32_t *coord;        /* 3n: brick coordinates */
-    size_t hcap;           /* power of two */
-    uint64_t *hkey;        /* packed coordinates + 1; 0 marks an empty slot */
-    int32_t *hval;
+    mf_hashmap map;        /* packed coordinates -> brick index, at most half full */
 } ls_bricks;
 
 /* Brick coordinates must stay within +-2^20 (checked against the grid). */
@@ -370,10 +370,6 @@ int ls_frame(ls_data *d, const mf_sim *sim, mf_mesh *out);
 
 /* ---- helpers ------------------------------------------------------------- */
 
-double ls_seconds(void);
-/* CPU time of the process, all threads (the machine may be shared: wall
- * time alone does not say what a frame costs). */
-double ls_cpu_seconds(void);
 /* The grid spacing a setting gives (0: l0 / 2). */
 static inline double ls_grid_spacing(double setting, double l0)
 {

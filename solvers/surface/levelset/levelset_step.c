@@ -161,21 +161,21 @@ int ls_frame(ls_data *d, const mf_sim *sim, mf_mesh *out)
     bool warm = false;
     int rc = 0;
 
-    double t = ls_seconds(), c = ls_cpu_seconds();
+    double t = mf_wall_seconds(), c = mf_cpu_seconds();
     MF_CALL_GOTO(rc, ls_field_setup(&f, sim->p, LS_KERNEL_LEVELSET, h, l0, s->radius, s->cutoff,
                                     (double)s->kernel_power, s->threshold, s->anisotropic, limit,
                                     what),
                  done);
-    d->t_field = ls_seconds() - t;
-    d->c_field = ls_cpu_seconds() - c;
-    t = ls_seconds();
-    c = ls_cpu_seconds();
+    d->t_field = mf_wall_seconds() - t;
+    d->c_field = mf_cpu_seconds() - c;
+    t = mf_wall_seconds();
+    c = mf_cpu_seconds();
     MF_CALL_GOTO(rc, ls_detect(&f, l0, limit, &cross), done);
-    d->t_detect = ls_seconds() - t;
-    d->c_detect = ls_cpu_seconds() - c;
+    d->t_detect = mf_wall_seconds() - t;
+    d->c_detect = mf_cpu_seconds() - c;
 
-    t = ls_seconds();
-    c = ls_cpu_seconds();
+    t = mf_wall_seconds();
+    c = mf_cpu_seconds();
     MF_CALL_GOTO(rc, ls_crossing_seeds(&cross, &fs, &nfs), done);
     warm = s->warm_start && d->have_previous && d->prev_h == h && d->band.b.n > 0;
     if (warm) {
@@ -198,11 +198,11 @@ int ls_frame(ls_data *d, const mf_sim *sim, mf_mesh *out)
     }
     MF_CALL_GOTO(rc, ls_band_from_seeds(&band, seeds, nseeds), done);
     MF_CALL_GOTO(rc, ls_band_fill_F(&band, &f, &cross.b, cross.F), done);
-    d->t_band = ls_seconds() - t;
-    d->c_band = ls_cpu_seconds() - c;
+    d->t_band = mf_wall_seconds() - t;
+    d->c_band = mf_cpu_seconds() - c;
 
-    t = ls_seconds();
-    c = ls_cpu_seconds();
+    t = mf_wall_seconds();
+    c = mf_cpu_seconds();
     ls_evolve_opts o = {
         .imex = d->imex,
         .alpha = s->alpha,
@@ -214,14 +214,14 @@ int ls_frame(ls_data *d, const mf_sim *sim, mf_mesh *out)
         .max_pseudo_time = s->max_pseudo_time,
     };
     MF_CALL_GOTO(rc, ls_evolve(&band, &f, &o, &d->last), done);
-    d->t_evolve = ls_seconds() - t;
-    d->c_evolve = ls_cpu_seconds() - c;
+    d->t_evolve = mf_wall_seconds() - t;
+    d->c_evolve = mf_cpu_seconds() - c;
 
-    t = ls_seconds();
-    c = ls_cpu_seconds();
+    t = mf_wall_seconds();
+    c = mf_cpu_seconds();
     MF_CALL_GOTO(rc, ls_mesh_extract(&band.b, band.nb, NULL, band.phi, band.flag, h, out), done);
-    d->t_mesh = ls_seconds() - t;
-    d->c_mesh = ls_cpu_seconds() - c;
+    d->t_mesh = mf_wall_seconds() - t;
+    d->c_mesh = mf_cpu_seconds() - c;
     if (ls_band_memory(&band) > d->peak_band_bytes)
         d->peak_band_bytes = ls_band_memory(&band);
     log_frame(d, sim, h, &f, &cross, &band, warm, nkept, nnew, out);

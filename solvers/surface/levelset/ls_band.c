@@ -16,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_alloc.h"
 #include "levelset.h"
 
 #define BUCKET 0.0625
@@ -77,19 +78,10 @@ int ls_band_brick(ls_band *band, int32_t bx, int32_t by, int32_t bz, int32_t *in
                                 band->b.n, (double)band->b.n * per / 1073741824.0,
                                 band->mem_limit / 1073741824.0);
         }
-        double *phi = realloc(band->phi, cap * LS_B3 * sizeof *phi);
-        if (phi)
-            band->phi = phi;
-        float *F = phi ? realloc(band->F, cap * LS_B3 * sizeof *F) : NULL;
-        if (F)
-            band->F = F;
-        uint8_t *flag = F ? realloc(band->flag, cap * LS_B3) : NULL;
-        if (flag)
-            band->flag = flag;
-        int32_t *idx = flag ? realloc(band->idx, cap * LS_B3 * sizeof *idx) : NULL;
-        if (idx)
-            band->idx = idx;
-        if (!idx)
+        if (mf_resize(&band->phi, cap * LS_B3, sizeof *band->phi) ||
+            mf_resize(&band->F, cap * LS_B3, sizeof *band->F) ||
+            mf_resize(&band->flag, cap * LS_B3, 1) ||
+            mf_resize(&band->idx, cap * LS_B3, sizeof *band->idx))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for a band of %zu bricks", cap);
         band->cap = cap;
     }
@@ -138,10 +130,8 @@ static int queue_push(bucket_queue *q, size_t bucket, uint32_t item)
 {
     if (q->n[bucket] == q->cap[bucket]) {
         size_t cap = q->cap[bucket] ? 2 * q->cap[bucket] : 256;
-        uint32_t *it = realloc(q->items[bucket], cap * sizeof *it);
-        if (!it)
+        if (mf_resize(&q->items[bucket], cap, sizeof *q->items[bucket]))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory in fast marching");
-        q->items[bucket] = it;
         q->cap[bucket] = cap;
     }
     q->items[bucket][q->n[bucket]++] = item;
@@ -280,17 +270,13 @@ static int sort_by_brick(uint32_t *h, size_t n, size_t nbricks, size_t **count, 
     if (n < 2)
         return 0;
     if (*ncount < nbricks + 1) {
-        size_t *c = realloc(*count, (nbricks + 1) * sizeof *c);
-        if (!c)
+        if (mf_resize(count, nbricks + 1, sizeof **count))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory in fast marching");
-        *count = c;
         *ncount = nbricks + 1;
     }
     if (*ntmp < n) {
-        uint32_t *t = realloc(*tmp, n * sizeof *t);
-        if (!t)
+        if (mf_resize(tmp, n, sizeof **tmp))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory in fast marching");
-        *tmp = t;
         *ntmp = n;
     }
     size_t *c = *count;
@@ -380,10 +366,8 @@ static int seed_push(seed_list *l, int32_t x, int32_t y, int32_t z, double phi)
 {
     if (l->n == l->cap) {
         size_t cap = l->cap ? 2 * l->cap : 4096;
-        ls_seed *s = realloc(l->s, cap * sizeof *s);
-        if (!s)
+        if (mf_resize(&l->s, cap, sizeof *l->s))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu seeds", cap);
-        l->s = s;
         l->cap = cap;
     }
     l->s[l->n++] = (ls_seed){x, y, z, phi};
@@ -579,10 +563,8 @@ int ls_band_activate(ls_band *band)
     if (n > (size_t)INT32_MAX)
         return MF_ERROR(MF_ERR_MEMORY, "%zu active band points: too many", n);
     if (n > band->cap_act) {
-        uint32_t *act = realloc(band->act, n * sizeof *act);
-        if (!act)
+        if (mf_resize(&band->act, n, sizeof *band->act))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu active band points", n);
-        band->act = act;
         band->cap_act = n;
     }
     size_t k = 0;

@@ -2,28 +2,14 @@
  * (OpenVDB's leaf nodes, without the tree above them). Only bricks that
  * hold band points exist, so memory follows the surface, not the box.
  *
- * Open addressing with linear probing on a splitmix64 hash of the packed
- * brick coordinates; the table is at most half full. */
+ * The bricks' index is mf_hashmap.h's map from the packed brick coordinates,
+ * at most half full. */
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 #include <unistd.h>
 
+#include "mf_alloc.h"
 #include "levelset.h"
-
-double ls_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-double ls_cpu_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 size_t ls_memory_limit(double max_memory_mb)
 {
@@ -42,16 +28,6 @@ static inline uint64_t pack(int32_t bx, int32_t by, int32_t bz)
             (uint64_t)(bz + (int64_t)bias) << 42) + 1;
 }
 
-static inline uint64_t mix(uint64_t x)
-{
-    x ^= x >> 30;
-    x *= 0xbf58476d1ce4e5b9ULL;
-    x ^= x >> 27;
-    x *= 0x94d049bb133111ebULL;
-    x ^= x >> 31;
-    return x;
-}
-
 void ls_bricks_init(ls_bricks *b)
 {
     memset(b, 0, sizeof *b);
@@ -60,54 +36,33 @@ void ls_bricks_init(ls_bricks *b)
 void ls_bricks_free(ls_bricks *b)
 {
     free(b->coord);
-    free(b->hkey);
-    free(b->hval);
+    mf_hashmap_free(&b->map);
     ls_bricks_init(b);
 }
 
 void ls_bricks_clear(ls_bricks *b)
 {
     b->n = 0;
-    if (b->hkey)
-        memset(b->hkey, 0, b->hcap * sizeof *b->hkey);
+    mf_hashmap_clear(&b->map);
 }
 
 int32_t ls_bricks_find(const ls_bricks *b, int32_t bx, int32_t by, int32_t bz)
 {
-    if (b->hcap == 0)
-        return LS_NONE;
-    const uint64_t key = pack(bx, by, bz), mask = b->hcap - 1;
-    for (uint64_t s = mix(key) & mask;; s = (s + 1) & mask) {
-        if (b->hkey[s] == key)
-            return b->hval[s];
-        if (b->hkey[s] == 0)
-            return LS_NONE;
-    }
+    uint32_t k = mf_hashmap_get(&b->map, pack(bx, by, bz));
+    return k == MF_HASHMAP_EMPTY ? LS_NONE : (int32_t)k;
 }
 
+/* A table of hcap slots holding every brick; the old one stays on failure. */
 static int rehash(ls_bricks *b, size_t hcap)
 {
-    uint64_t *hkey = calloc(hcap, sizeof *hkey);
-    int32_t *hval = malloc(hcap * sizeof *hval);
-    if (!hkey || !hval) {
-        free(hkey);
-        free(hval);
-        return MF_ERROR(MF_ERR_MEMORY, "out of memory for a brick table of %zu slots", hcap);
-    }
-    const uint64_t mask = hcap - 1;
+    mf_hashmap t = {0, NULL, NULL};
+    MF_CALL(mf_hashmap_reset(&t, hcap, 0));
     for (size_t k = 0; k < b->n; k++) {
         const int32_t *c = &b->coord[3 * k];
-        uint64_t key = pack(c[0], c[1], c[2]), s = mix(key) & mask;
-        while (hkey[s] != 0)
-            s = (s + 1) & mask;
-        hkey[s] = key;
-        hval[s] = (int32_t)k;
+        mf_hashmap_put_new(&t, pack(c[0], c[1], c[2]), (uint32_t)k);
     }
-    free(b->hkey);
-    free(b->hval);
-    b->hkey = hkey;
-    b->hval = hval;
-    b->hcap = hcap;
+    mf_hashmap_free(&b->map);
+    b->map = t;
     return 0;
 }
 
@@ -130,26 +85,19 @@ int ls_bricks_insert(ls_bricks *b, int32_t bx, int32_t by, int32_t bz, int32_t *
     }
     if (b->n >= (size_t)INT32_MAX - 1)
         return MF_ERROR(MF_ERR_MEMORY, "more than %d bricks in the surface grid", INT32_MAX);
-    if (2 * (b->n + 1) > b->hcap)
-        MF_CALL(rehash(b, b->hcap ? 2 * b->hcap : 1024));
+    if (2 * (b->n + 1) > b->map.cap)
+        MF_CALL(rehash(b, b->map.cap ? 2 * b->map.cap : 1024));
     if (b->n == b->cap) {
         size_t cap = b->cap ? 2 * b->cap : 256;
-        int32_t *coord = realloc(b->coord, 3 * cap * sizeof *coord);
-        if (!coord)
+        if (mf_resize(&b->coord, 3 * cap, sizeof *b->coord))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu bricks", cap);
-        b->coord = coord;
         b->cap = cap;
     }
     int32_t k = (int32_t)b->n++;
     b->coord[3 * k] = bx;
     b->coord[3 * k + 1] = by;
     b->coord[3 * k + 2] = bz;
-    const uint64_t key = pack(bx, by, bz), mask = b->hcap - 1;
-    uint64_t s = mix(key) & mask;
-    while (b->hkey[s] != 0)
-        s = (s + 1) & mask;
-    b->hkey[s] = key;
-    b->hval[s] = k;
+    mf_hashmap_put_new(&b->map, pack(bx, by, bz), (uint32_t)k);
     *index = k;
     if (added)
         *added = true;
@@ -158,7 +106,7 @@ int ls_bricks_insert(ls_bricks *b, int32_t bx, int32_t by, int32_t bz, int32_t *
 
 size_t ls_bricks_memory(const ls_bricks *b)
 {
-    return b->cap * 3 * sizeof(int32_t) + b->hcap * (sizeof(uint64_t) + sizeof(int32_t));
+    return b->cap * 3 * sizeof(int32_t) + mf_hashmap_memory(&b->map);
 }
 
 int ls_bricks_neighbours(const ls_bricks *b, int32_t **nb)

@@ -21,6 +21,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_alloc.h"
 #include "levelset.h"
 
 #define CHUNK 256
@@ -51,10 +52,8 @@ static int crossing_add(ls_crossing *c, const int32_t *bc, const float *v9, size
                             "the surface crosses %zu bricks of 8^3 cells: more than the memory "
                             "limit of %.3g GB allows (maxMemory); use a coarser gridSpacing",
                             c->b.n, mem_limit / 1073741824.0);
-        float *F = realloc(c->F, cap * LS_B3 * sizeof *F);
-        if (!F)
+        if (mf_resize(&c->F, cap * LS_B3, sizeof *c->F))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu crossing bricks", cap);
-        c->F = F;
         c->cap = cap;
     }
     if (*added) {
@@ -121,10 +120,8 @@ static int work_push(work_list *w, int32_t x, int32_t y, int32_t z)
 {
     if (w->n == w->cap) {
         size_t cap = w->cap ? 2 * w->cap : 1024;
-        int32_t *c = realloc(w->c, 3 * cap * sizeof *c);
-        if (!c)
+        if (mf_resize(&w->c, 3 * cap, sizeof *w->c))
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for a list of %zu bricks", cap);
-        w->c = c;
         w->cap = cap;
     }
     w->c[3 * w->n] = x;

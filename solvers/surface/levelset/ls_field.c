@@ -23,6 +23,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_alloc.h"
 #include "levelset.h"
 
 /* Bricks are binned with this margin (cells) beyond a particle's support, so
@@ -119,12 +120,10 @@ static int bin_particles(ls_field *f, size_t mem_limit, double h, const char *wh
                     int rc = ls_bricks_insert(&f->touched, bx, by, bz, &k, NULL);
                     if (rc == 0 && (size_t)k >= cap_count) {
                         size_t cap = cap_count ? 2 * cap_count : 4096;
-                        size_t *grown = realloc(count, cap * sizeof *grown);
-                        if (!grown)
+                        if (mf_resize(&count, cap, sizeof *count))
                             rc = MF_ERROR(MF_ERR_MEMORY, "out of memory binning particles");
                         else {
-                            memset(grown + cap_count, 0, (cap - cap_count) * sizeof *grown);
-                            count = grown;
+                            memset(count + cap_count, 0, (cap - cap_count) * sizeof *count);
                             cap_count = cap;
                         }
                     }

@@ -1,0 +1,89 @@
+/* mps_source.c: the source term of the pressure equation, per scheme.
+ *
+ * mps_ppe.c solves -<lap p> = rho s_i (s_i / 1 with a density per particle,
+ * where the operator carries 1/rho). With `source density` s_i is eq. 14 as
+ * printed, computed in mps_ppe.c itself:
+ *   s_i = relaxation (n*_i - n0) / (n0 dt^2).
+ * The others are computed here into d->src:
+ *
+ * mixed (Tanaka & Masunaga 2010, J. Comput. Phys. 229, 4279-4290, eq. 21;
+ * Kondo & Koshizuka 2011, Int. J. Numer. Meth. Fluids 65, 638-654): the
+ * velocity divergence of u* (eq. 6, projected to zero by the correction)
+ * plus a small share gamma (densityFactor) of the density deviation at the
+ * start of the step, which keeps the volume from drifting:
+ *   s_i = -<div u*>_i / dt + gamma (n^k_i - n0) / (n0 dt^2).
+ * Its main term grows as 1/dt, not 1/dt^2: a shorter step does not amplify
+ * the particle-scale noise of n*.
+ *
+ * higherOrder (Khayyer & Gotoh 2009, Coastal Eng. 56, 419-440, eqs. 11-13):
+ * the rate of the number density from the pair velocities,
+ *   s_i = (Dn/Dt)*_i / (n0 dt),  Dn/Dt_i = sum_j -re (r_ij . u_ij) / |r_ij|^3
+ * (mf_number_density_rate, at r* with u*, the number density's radius).
+ *
+ * errorCompensating (Khayyer & Gotoh 2011, J. Comput. Phys. 230, 3093-3118,
+ * eqs. 16-19): the higher-order source plus terms that compensate the
+ * error of the last step with coefficients set by that error itself,
+ *   s_i += alpha (Dn/Dt)^k_i / (n0 dt) + beta (n^k_i - n0) / (n0 dt^2),
+ *   alpha = |n^k_i - n0| / n0,  beta = |dt (Dn/Dt)^k_i| / n0
+ * (k: the start of the step, r^n and u^n).
+ *
+ * The density terms are multiplied by d->density_scale, 1 except when the
+ * time loop retries a step with a shorter dt (mps_step.c): a density error
+ * corrected in one step needs a velocity of (n - n0)/n0 l / dt, which the
+ * retry's halving would double each time.
+ */
+#include <math.h>
+
+#include "mf_error.h"
+#include "mf_operators.h"
+#include "mps.h"
+
+int mps_source_start(mps_data *d, mf_sim *sim)
+{
+    const mps_source_kind src = d->sc.source;
+    if (src != MPS_SOURCE_MIXED && src != MPS_SOURCE_ERROR_COMPENSATING)
+        return 0;
+    MF_CALL(mps_scheme_reserve(d, sim->p->n));
+    mf_pairs v;
+    MF_CALL(mps_pairs(d, sim, d->h_nd, &v));
+    mf_number_density(&v, d->not_dummy, NULL, d->n_start);
+    if (src == MPS_SOURCE_ERROR_COMPENSATING)
+        mf_number_density_rate(&v, sim->p->vel, d->not_dummy, NULL, d->rate_start);
+    return 0;
+}
+
+int mps_source_terms(mps_data *d, const mf_sim *sim, double dt)
+{
+    const mps_source_kind src = d->sc.source;
+    if (src == MPS_SOURCE_DENSITY)
+        return 0;
+    const mf_particles *p = sim->p;
+    MF_CALL(mps_scheme_reserve(d, p->n));
+    const double n0 = d->k_nd.n0, dt2 = dt * dt, scale = d->density_scale;
+    double *rate = d->work; /* the divergence or Dn/Dt at r* */
+    mf_pairs v;
+    if (src == MPS_SOURCE_MIXED) {
+        /* eq. 6 at the gradient's radius over the particles the gradient sees */
+        MF_CALL(mps_pairs(d, sim, d->h_grad, &v));
+        mf_divergence(&v, &d->k_grad, p->vel, d->in_ppe, d->not_dummy, rate);
+        const double gamma = d->s.density_factor * scale;
+        for (size_t i = 0; i < p->n_owned; i++)
+            if (d->in_ppe[i])
+                d->src[i] = -rate[i] / dt + gamma * (d->n_start[i] - n0) / (n0 * dt2);
+        return 0;
+    }
+    MF_CALL(mps_pairs(d, sim, d->h_nd, &v));
+    mf_number_density_rate(&v, p->vel, d->in_ppe, NULL, rate);
+    for (size_t i = 0; i < p->n_owned; i++) {
+        if (!d->in_ppe[i])
+            continue;
+        double s = rate[i] / (n0 * dt);
+        if (src == MPS_SOURCE_ERROR_COMPENSATING) {
+            const double dn = (d->n_start[i] - n0) / n0;
+            const double alpha = fabs(dn), beta = fabs(dt * d->rate_start[i]) / n0;
+            s += alpha * d->rate_start[i] / (n0 * dt) + scale * beta * dn / dt2;
+        }
+        d->src[i] = s;
+    }
+    return 0;
+}
