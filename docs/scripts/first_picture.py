@@ -2,14 +2,16 @@
 makes it (open output/particles.xdmf with the XDMF reader, draw points,
 colour by the magnitude of Velocities), without a window:
 
-    xvfb-run -a pvbatch docs/scripts/first_picture.py \
+    build/driver/mpsflowParaView docs/scripts/first_picture.py \
         tutorials/damBreak2D/output/particles.xdmf 0.3 damBreak2D.png
 
-argv: the XDMF index, the time to show (the nearest snapshot is used), the
-PNG to write. Needs ParaView (apt-get install paraview xvfb)."""
+(mpsflowParaView runs pvbatch, under an Xvfb of its own with a 24-bit
+screen and software OpenGL where there is no display.) argv: the XDMF index, the time
+to show (the nearest snapshot is used), the PNG to write. Needs ParaView
+(apt-get install paraview python3-paraview xvfb xauth libgl1-mesa-dri)."""
 import sys
 
-from paraview.simple import (ColorBy, GetActiveViewOrCreate, GetColorTransferFunction,
+from paraview.simple import (ColorBy, Delete, GetActiveViewOrCreate, GetColorTransferFunction,
                              GetScalarBar, Render, SaveScreenshot, Show, XDMFReader)
 
 xdmf, when, png = sys.argv[1], float(sys.argv[2]), sys.argv[3]
@@ -58,4 +60,9 @@ view.CameraParallelProjection = 1
 view.CameraParallelScale = 0.55 * max(y1 - y0, (x1 - x0) * height / width)
 Render(view)
 SaveScreenshot(png, view, ImageResolution=[width, height])
+# Leave nothing for pvbatch's exit to tear down: with a view still alive at
+# exit it aborts under Xvfb (GLXBadContext, "bad X server connection").
+Delete(display)
+Delete(reader)
+Delete(view)
 print("%s: t = %g s" % (png, t))
