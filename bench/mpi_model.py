@@ -3,7 +3,7 @@
 
 Prints strong scaling (a fixed total of particles) and weak scaling (a fixed
 count a rank) to 10,000 ranks, and the rank count where communication takes
-half the step. docs/incoming/mpi.md ("Scaling to 1,000 and 10,000 ranks")
+half the step. docs/topics/parallel.md ("Scaling to 1,000 and 10,000 ranks")
 explains every term and where each default was measured:
 
     bench/mpi_model.py                    the tables of the docs

@@ -1,7 +1,7 @@
 #!/bin/sh
 # Issue 13's failing cases under each MPS scheme: does the run reach its
 # endTime, and how (steps, retries, largest fluid speed, the watch's
-# diagnosis when it stops)? Not a test: a table for docs/incoming/schemes.md.
+# diagnosis when it stops)? Not a test: a table for docs/topics/schemes.md.
 #   bench/schemes_survival.sh [VARIANT ...]
 # VARIANT is one of
 #   paper     `scheme paper;` as printed (relaxation 1, no collision)

@@ -76,7 +76,7 @@ trip "fluid pushed apart" densityCollapse -endTime 0.2
 # another, a tolerance of 1e-8 or 1e-9), and so does what a retry of the
 # step meets: a particle may then pass the floor within the retried step
 # (throughWall, checked before energy). No retry: the first failure ends
-# the run. (The module's default scheme survives it: docs/incoming/schemes.md.)
+# the run. (The module's default scheme survives it: docs/topics/schemes.md.)
 fresh; sed -i 's/    relaxation      0.2;/    scheme          paper;/; s/    collision       yes;//' "$dir/case/system/solverDict"
 sed -i 's/^maxRetries.*//' "$dir/case/system/controlDict"; printf 'maxRetries 0;\n' >> "$dir/case/system/controlDict"
 trip "plain scheme blowing up" energy

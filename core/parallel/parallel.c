@@ -15,7 +15,7 @@ void mf_parallel_default_settings(mf_parallel_settings *s)
     /* Instructions a step per particle of each kind, relative to a fluid
      * particle (callgrind, the 3-D dam break at l0 = 0.02 m with 2 and 4
      * dummy layers, 1 and 2 wall layers, the column 0.25 and 0.5 m long;
-     * docs/incoming/mpi.md). */
+     * docs/topics/parallel.md). */
     s->weight[MF_FLUID] = 1.0;
     s->weight[MF_WALL] = 0.35;
     s->weight[MF_DUMMY] = 0.2;

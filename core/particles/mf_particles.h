@@ -121,7 +121,7 @@ size_t mf_particles_memory(const mf_particles *p); /* bytes held */
  * largest radius `radius_l0` (in particle spacings), whose entries are the
  * lattice points within it, and a snapshot's image (built in memory, then
  * written: io/hdf5/hdf5_writer.c). A model for refusing a scene before it is
- * built, not an accounting: docs/incoming/input.md compares it with peak
+ * built, not an accounting: docs/validation-and-performance.md compares it with peak
  * memory measured on the tutorials. */
 double mf_memory_per_particle(int dim, double radius_l0);
 

@@ -296,7 +296,7 @@ int mf_cmd_run(mf_app *app)
  * running, every barrier waits out a time slice, and two threads made a step
  * 25 to 40 times slower than one (the neighbour search: 1 ms to 400 ms).
  * Passive waiting (sleep at once) keeps two threads at or below one thread's
- * time on a loaded machine (docs/incoming/iface.md has the measurements).
+ * time on a loaded machine (docs/validation-and-performance.md has the measurements).
  * libgomp reads the policy from the environment when it loads, before main:
  * so set it and start again, unless the user chose a policy. */
 static void openmp_wait_policy(char **argv)

@@ -30,7 +30,7 @@
  *    the iterations of the hierarchy's first solve (at least two more).
  *    Without the rebuild a kept hierarchy ages: on the 2-D bench dam break
  *    the iterations grow from 5 to 8 over 25 steps and to 49 over 1000
- *    (docs/incoming/iface.md).
+ *    (docs/validation-and-performance.md).
  *  - reuseSetup > 0 keeps the hierarchy for that many further solves as
  *    long as the matrix size and sparsity pattern do not change (the
  *    implicit viscosity: one matrix, a solve per velocity component).

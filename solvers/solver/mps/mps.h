@@ -174,7 +174,7 @@ extern const char *const mps_scheme_choices[], *const mps_source_choices[],
 /* The entries of that table, for a solver whose settings embed an
  * mps_settings (the multi-fluid solver): OFF(field) is the offset of the
  * embedded field in the embedding struct; SCHEME the solver's default scheme
- * (docs/incoming/schemes.md: MPS robust; MAFL and multiFluid paper, where
+ * (docs/topics/schemes.md: MPS robust; MAFL and multiFluid paper, where
  * robust was measured to lose MAFL points and to break the droplets'
  * free-surface pressure). One list, three tables.
  * reNumberDensity 3.1 rather than Koshizuka & Oka's 2.1: on hydrostatic2D

@@ -69,7 +69,7 @@ int mps_create_solve(const mf_sim *sim, const mf_dict *solver_dict, const char *
  * hierarchy kept across steps (reuseHierarchy), no aggressive coarsening in
  * 2-D (its costlier set-up, made once per hierarchy, is repaid by fewer
  * and cheaper iterations at every step); in 3-D the module's one level
- * (without it the coarse levels are too dense). docs/incoming/iface.md has
+ * (without it the coarse levels are too dense). docs/validation-and-performance.md has
  * the measurements. */
 static int create_pressure(mps_data *d, mf_sim *sim, const mf_dict *solver_dict)
 {

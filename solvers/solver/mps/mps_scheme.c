@@ -15,7 +15,7 @@
  *            Laplacian, free surface by eq. 18 and neighbour asymmetry
  *            (Khayyer et al. 2009), the collision model, no shifting: the
  *            variant that survived the failing cases of issue 13 in the
- *            measurements of docs/incoming/schemes.md (there Fickian
+ *            measurements of docs/topics/schemes.md (there Fickian
  *            shifting added energy at small dt, the mixed source with
  *            gamma 0.05 blew up the obstacle dam break, and the
  *            error-compensating source left hydrostatic2D's pressure 5%
