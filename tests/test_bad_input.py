@@ -433,21 +433,21 @@ EXPECTED.update({
     'unknown solver':
         "--> mpsflow FATAL ERROR: unknown solver module 'MSP' (did you mean 'MPS'?); valid solver modules: MPS, multiFluid, MAFL",
     'unknown top-level key':
-        "--> mpsflow FATAL ERROR: {case}/system/solverDict:39:1: unknown key 'MSPCoeffs' in '(top level)' (did you mean 'MPSCoeffs'?); valid keys: solver, pressure, viscosity, forces, FoamFile, MPSCoeffs, multiFluidCoeffs, MAFLCoeffs",
+        "--> mpsflow FATAL ERROR: {case}/system/solverDict:36:1: unknown key 'MSPCoeffs' in '(top level)' (did you mean 'MPSCoeffs'?); valid keys: solver, pressure, viscosity, forces, FoamFile, MPSCoeffs, multiFluidCoeffs, MAFLCoeffs",
     'unknown coefficient':
-        "--> mpsflow FATAL ERROR: {case}/system/solverDict:21:5: unknown key 'bta' in 'MPSCoeffs' (did you mean 'beta'?); valid keys: reNumberDensity, reGradient, reLaplacian, beta, relaxation, compressibility, clipNegativePressure, gradientPmin, scheme, source, densityFactor, gradient, laplacian, shifting, shiftCoefficient, shiftMax, surfaceDetection, asymmetry, retrySource, collision, collisionAfterCorrection, collisionDistance, restitution, reorderInterval, viscosity, periodicLength, periodicOrigin",
+        "--> mpsflow FATAL ERROR: {case}/system/solverDict:20:5: unknown key 'bta' in 'MPSCoeffs' (did you mean 'beta'?); valid keys: reNumberDensity, reGradient, reLaplacian, beta, relaxation, compressibility, clipNegativePressure, gradientPmin, scheme, source, densityFactor, gradient, laplacian, shifting, shiftCoefficient, shiftMax, surfaceDetection, asymmetry, retrySource, collision, collisionAfterCorrection, collisionDistance, restitution, reorderInterval, viscosity, periodicLength, periodicOrigin",
     'beta out of range':
-        "--> mpsflow FATAL ERROR: {case}/system/solverDict:21:5: key 'beta': 2 is out of range [0.5, 1] (free surface where n* < beta n0 (eq. 18))",
+        "--> mpsflow FATAL ERROR: {case}/system/solverDict:20:5: key 'beta': 2 is out of range [0.5, 1] (free surface where n* < beta n0 (eq. 18))",
     'reLaplacian out of range':
-        "--> mpsflow FATAL ERROR: {case}/system/solverDict:20:5: key 'reLaplacian': 50 is out of range [1.01, 10] (radius of the Laplacian (viscosity, pressure equation), in l0)",
+        "--> mpsflow FATAL ERROR: {case}/system/solverDict:19:5: key 'reLaplacian': 50 is out of range [1.01, 10] (radius of the Laplacian (viscosity, pressure equation), in l0)",
     'unknown pressure solver':
         "--> mpsflow FATAL ERROR: unknown pressure module 'PCG_AMG'; valid pressure modules: PCG_BoomerAMG, PCG_diagonal",
     'pressure tolerance 0':
-        "--> mpsflow FATAL ERROR: {case}/system/solverDict:29:5: key 'tolerance': 0 is out of range [1e-16, 1] (relative residual ||b - A x|| / ||b|| to reach)",
+        "--> mpsflow FATAL ERROR: {case}/system/solverDict:26:5: key 'tolerance': 0 is out of range [1e-16, 1] (relative residual ||b - A x|| / ||b|| to reach)",
     'gravity not a vector':
-        "--> mpsflow FATAL ERROR: {case}/system/solverDict:34:5: force 'gravity': {case}/system/solverDict:36:11: key 'g': expected a vector (a list of 3 numbers, like (0 -9.81 0)), found a list of 2 items",
+        "--> mpsflow FATAL ERROR: {case}/system/solverDict:31:5: force 'gravity': {case}/system/solverDict:33:11: key 'g': expected a vector (a list of 3 numbers, like (0 -9.81 0)), found a list of 2 items",
     'unknown force':
-        "--> mpsflow FATAL ERROR: {case}/system/solverDict:39:1: unknown key 'forces2' in '(top level)' (did you mean 'forces'?); valid keys: solver, pressure, viscosity, forces, FoamFile, MPSCoeffs, multiFluidCoeffs, MAFLCoeffs",
+        "--> mpsflow FATAL ERROR: {case}/system/solverDict:36:1: unknown key 'forces2' in '(top level)' (did you mean 'forces'?); valid keys: solver, pressure, viscosity, forces, FoamFile, MPSCoeffs, multiFluidCoeffs, MAFLCoeffs",
     'rho 0':
         "--> mpsflow FATAL ERROR: {case}/constant/fluids:11:5: key 'rho': 0 is out of range [0.001, 1e+06] (density, kg/m^3. One fluid's density only scales the pressure; between fluids the ratio conditions the pressure equation: from hydrogen (0.09) past mercury (13,600), with a margin)",
     'nu negative':

@@ -36,7 +36,7 @@
  * integral of sigma kappa n over a closed interface is zero, and on
  * particles only up to the error of kappa and n. On lattice drops it is
  * zero to rounding (1e-16); jittered by 0.1 l0 it is 0.5-3% of sum m |a|
- * (docs/incoming/iface.md has the table), and it does not fall with
+ * (docs/validation-and-performance.md has the table), and it does not fall with
  * resolution, since the jitter is noise at the particle scale. The bound
  * catches what breaks the closure (a wrong curvature sign on part of an
  * interface gives tens of per cent), not the discretisation's noise. */

@@ -77,7 +77,9 @@ trip "fluid pushed apart" densityCollapse -endTime 0.2
 # step meets: a particle may then pass the floor within the retried step
 # (throughWall, checked before energy). No retry: the first failure ends
 # the run. (The module's default scheme survives it: docs/topics/schemes.md.)
-fresh; sed -i 's/    relaxation      0.2;/    scheme          paper;/; s/    collision       yes;//' "$dir/case/system/solverDict"
+fresh; awk '{ print } /^MPSCoeffs[ ]*$/ { want = 1; next } want && /^[{]/ { print "    scheme          paper;"; want = 0 }' \
+    "$dir/case/system/solverDict" > "$dir/solverDict" && mv "$dir/solverDict" "$dir/case/system/solverDict"
+grep -q "scheme          paper;" "$dir/case/system/solverDict" || { echo "FAIL could not set scheme paper"; exit 1; }
 sed -i 's/^maxRetries.*//' "$dir/case/system/controlDict"; printf 'maxRetries 0;\n' >> "$dir/case/system/controlDict"
 trip "plain scheme blowing up" energy
 
