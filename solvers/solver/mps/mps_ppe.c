@@ -205,8 +205,8 @@ static bool ppe_row(const void *ctx, size_t i, size_t r)
     const size_t diag = c->rows.rowptr[r];
     const double sum = mf_pairs_row_assemble(&c->v, i, d->not_dummy, NULL, ppe_coef, ppe_known,
                                              c, &acc, &c->rows, r);
-    if (!(sum > 0) && d->is_fluid[i])
-        return false;
+    if (!(sum > 0) && d->is_fluid[i] && !d->wall)
+        return false; /* (wall weight: a particle with only the wall near takes p = 0 below) */
     const double dt2 = c->dt * c->dt;
     /* n* - n0, or against a per-particle reference (mps_data.n_offset) */
     const double dn = d->n_offset ? c->n[i] - c->n0 - d->n_offset[i] : c->n[i] - c->n0;
@@ -217,6 +217,8 @@ static bool ppe_row(const void *ctx, size_t i, size_t r)
     } else {
         val[diag] = sum + d->s.compressibility * c->rho / dt2;
         d->rhs[r] = c->src ? c->rho * c->src[i] : d->s.relaxation * c->rho / dt2 * dn / c->n0;
+        if (d->wall) /* the walls' part of the Laplacian, known (mf_wall_ppe_rhs) */
+            d->rhs[r] += mps_wall_ppe_rhs(d, i, c->rho);
     }
     if (c->walls_push && !d->is_fluid[i] && d->rhs[r] < 0)
         d->rhs[r] = 0; /* surfaceDetection asymmetry: a wall pushes, never pulls */

@@ -137,9 +137,13 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
     mf_particles *p = sim->p;
     const double nu = sim->fluid[0].nu;
     retry_scale(d, sim, dt);
+    if (d->wall) /* wall weight: the walls' sums at r^n */
+        MF_CALL(mps_wall_points(d, sim));
     MF_CALL(mps_source_start(d, sim)); /* what the scheme's source needs of r^n, u^n */
     memset(d->acc, 0, 3 * p->n * sizeof *d->acc);
     MF_CALL(mf_force_accumulate(sim, d->acc));
+    if (d->wall) /* the force acceleration continues the pressure into the walls */
+        mps_wall_keep_forces(d, sim);
     if (d->visc) { /* viscosity implicit: u* = (I - dt nu lap)^-1 (u + dt a), r* = r + dt u* */
         MF_CALL(mps_viscosity_implicit(d, sim, dt));
     } else if ((d->mu || nu > 0) && d->sc.laplacian != MPS_LAPLACIAN_PAPER) {
@@ -153,6 +157,8 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
         else
             mf_laplacian_add(&v, &d->k_lap, p->vel, nu, d->is_fluid, NULL, d->acc);
     }
+    if (d->wall && nu > 0) /* no slip on the walls' faces */
+        mps_wall_viscous(d, sim, nu);
     for (size_t i = 0; i < p->n_owned && !d->visc; i++) {
         if (!d->is_fluid[i])
             continue;
@@ -165,6 +171,8 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
         MF_CALL(mps_halo_sync_motion(d, sim));
     if (d->s.collision)
         MF_CALL(collide(d, sim, dt));
+    if (d->s.collision && d->wall)
+        MF_CALL(mps_wall_collide(d, sim, dt));
     d->t_explicit += mf_wall_seconds() - t0;
     return 0;
 }
@@ -220,6 +228,10 @@ int mps_surface_phase(mps_data *d, mf_sim *sim)
     mf_pairs v;
     MF_CALL(mps_pairs(d, sim, d->h_nd, &v));
     mf_number_density(&v, d->not_dummy, NULL, n);
+    if (d->wall) { /* the walls' sums at r*, their number density */
+        MF_CALL(mps_wall_points(d, sim));
+        mps_wall_number_density(d, sim, n);
+    }
     const double n0 = d->k_nd.n0;
     if (d->sc.detection == MPS_DETECT_ASYMMETRY)
         MF_CALL(detect_by_asymmetry(d, sim, &v));
@@ -278,6 +290,12 @@ int mps_correction_phase(mps_data *d, mf_sim *sim, double dt)
     MF_CALL(mps_pairs(d, sim, d->h_grad, &v));
     mf_gradient(&v, &d->k_grad, pr, d->s.gradient_pmin, d->is_fluid, d->not_dummy, d->grad);
     const double rho = sim->fluid[0].rho;
+    if (d->wall) { /* the walls' part, with eq. 5's p^ of each particle */
+        MF_CALL(mps_scheme_reserve(d, p->n));
+        double *phat = d->work;
+        mf_neighbour_min(&v, pr, d->s.gradient_pmin, NULL, d->is_fluid, d->not_dummy, phat);
+        mps_wall_gradient(d, sim, pr, phat, rho);
+    }
     for (size_t i = 0; i < p->n_owned; i++) {
         if (!d->is_fluid[i])
             continue;
