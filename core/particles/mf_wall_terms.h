@@ -5,14 +5,18 @@
  * pair engine summed over the particles.
  *
  * The wall's virtual points v (offsets from the particle i) carry
- *   velocity  u_v = u_w - (s_v/d)(u_i - u_w)  (no slip on the face: Morris,
- *             Fox & Zhu 1997, as mf_wall_sums.visc),
- *   pressure  p_v = p_i + rho (f - a_w).v      (the hydrostatic continuation
- *             of the particle's pressure into the wall, Harada, Koshizuka &
- *             Shimazaki 2008, Trans. JSCES 20080006: f the force
- *             acceleration, a_w the wall's acceleration),
+ *   velocity  u_v = u_w in the divergence (the source's wall term), and
+ *             u_v = u_w - (s_v/d)(u_i - u_w) in the viscous term (no slip
+ *             on the face: Morris, Fox & Zhu 1997, as mf_wall_sums.visc),
+ *   pressure  p_v = p_i in the pressure equation's Laplacian (the wall's
+ *             flux is the divergence's wall term: a second, hydrostatic one
+ *             would count it twice), and p_v = p_i + rho a.v in the
+ *             gradient, the particle's pressure continued into the wall
+ *             (Harada, Koshizuka & Shimazaki 2008, Trans. JSCES 20080006,
+ *             continue it hydrostatically; a is the solver's choice, the
+ *             force acceleration at rest),
  * so that each operator's sum over the virtual points is a combination of
- * the tabulated zn, g, t, m and visc. */
+ * the tabulated zn, g, t and visc. */
 #ifndef MF_WALL_TERMS_H
 #define MF_WALL_TERMS_H
 
@@ -36,34 +40,24 @@ static inline double mf_wall_divergence(const mf_wall_sums *s, const mf_kernel *
 }
 
 /* eq. 5 on the continued pressure: d/n0 sum_v (p_v - p^_i) v/|v|^2 w
- *   = d/n0 [(p_i - p^_i) g + rho (t f - t_a)]
- * (t_a = t a_w summed over the solids); added to grad (k: the gradient's
- * kernel). The first term is the wall's repulsion where the particle's
- * pressure exceeds its neighbourhood's minimum, the second the wall's
- * share of the hydrostatic gradient. */
+ *   = d/n0 [(p_i - p^_i) g + rho t a]
+ * added to grad (k: the gradient's kernel). The first term is the wall's
+ * repulsion where the particle's pressure exceeds its neighbourhood's
+ * minimum, the second the wall's share of the pressure gradient rho a (at
+ * rest the hydrostatic one: with p^ from a full lattice the two add up to
+ * rho f exactly). */
 static inline void mf_wall_gradient_add(const mf_wall_sums *s, const mf_kernel *k, double p_i,
-                                        double phat_i, double rho, const double f[3],
-                                        const double t_a[3], double grad[3])
+                                        double phat_i, double rho, const double a[3],
+                                        double grad[3])
 {
     const double T[3][3] = {{s->t[0], s->t[3], s->t[4]},
                             {s->t[3], s->t[1], s->t[5]},
                             {s->t[4], s->t[5], s->t[2]}};
     const double c = k->dim / k->n0;
-    for (int a = 0; a < 3; a++) {
-        const double tf = T[a][0] * f[0] + T[a][1] * f[1] + T[a][2] * f[2];
-        grad[a] += c * ((p_i - phat_i) * s->g[a] + rho * (tf - t_a[a]));
+    for (int q = 0; q < 3; q++) {
+        const double ta = T[q][0] * a[0] + T[q][1] * a[1] + T[q][2] * a[2];
+        grad[q] += c * ((p_i - phat_i) * s->g[q] + rho * ta);
     }
-}
-
-/* eq. 7 on the continued pressure: 2d/(lambda n0) sum_v (p_v - p_i) w
- * = 2d/(lambda n0) rho (f.m - m_a) (m_a = m . a_w summed over the solids):
- * nothing on the diagonal, a known term that the PPE row -<lap p>_i = rho s_i
- * moves to its right-hand side (k: the Laplacian's kernel). */
-static inline double mf_wall_ppe_rhs(const mf_wall_sums *s, const mf_kernel *k, double rho,
-                                     const double f[3], double m_a)
-{
-    const double fm = f[0] * s->m[0] + f[1] * s->m[1] + f[2] * s->m[2];
-    return 2.0 * k->dim / (k->lambda * k->n0) * rho * (fm - m_a);
 }
 
 /* eq. 7 on the no-slip velocity: nu 2d/(lambda n0) sum_v (u_v - u_i) w

@@ -388,13 +388,15 @@ int mps_wall_create(mps_data *d, mf_sim *sim, const mf_dict *solver_dict);
 void mps_wall_destroy(struct mps_wall *w);
 /* The wall weight sums of the owned fluid particles at their positions. */
 int mps_wall_points(mps_data *d, const mf_sim *sim);
-/* d->acc (the forces only) kept for the continued wall pressure. */
+/* d->acc (the forces only) kept for the pressure continued into the walls. */
 void mps_wall_keep_forces(mps_data *d, const mf_sim *sim);
+/* After the explicit update (u = u*): across each wall face the forces'
+ * acceleration replaced by (u* - u_w).n / dt. */
+void mps_wall_keep_approach(mps_data *d, const mf_sim *sim, double dt);
 void mps_wall_number_density(const mps_data *d, const mf_sim *sim, double *n);
 void mps_wall_viscous(mps_data *d, const mf_sim *sim, double nu);              /* into d->acc */
 void mps_wall_divergence(const mps_data *d, const mf_sim *sim, const uint8_t *imask,
                          double *div);
-double mps_wall_ppe_rhs(const mps_data *d, size_t i, double rho);             /* row i's known */
 /* Into d->grad; phat: p^ of eq. 5 (the neighbourhood's minimum or p). */
 void mps_wall_gradient(const mps_data *d, const mf_sim *sim, const double *pressure,
                        const double *phat, double rho);

@@ -217,8 +217,6 @@ static bool ppe_row(const void *ctx, size_t i, size_t r)
     } else {
         val[diag] = sum + d->s.compressibility * c->rho / dt2;
         d->rhs[r] = c->src ? c->rho * c->src[i] : d->s.relaxation * c->rho / dt2 * dn / c->n0;
-        if (d->wall) /* the walls' part of the Laplacian, known (mf_wall_ppe_rhs) */
-            d->rhs[r] += mps_wall_ppe_rhs(d, i, c->rho);
     }
     if (c->walls_push && !d->is_fluid[i] && d->rhs[r] < 0)
         d->rhs[r] = 0; /* surfaceDetection asymmetry: a wall pushes, never pulls */

@@ -167,6 +167,8 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
             p->pos[3 * i + c] += dt * p->vel[3 * i + c];
         }
     }
+    if (d->wall) /* u*: what the wall's pressure will stop (mps_wall.c) */
+        mps_wall_keep_approach(d, sim, dt);
     if (d->halo) /* copies move with their owners (the collision model reads them) */
         MF_CALL(mps_halo_sync_motion(d, sim));
     if (d->s.collision)

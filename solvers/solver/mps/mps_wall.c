@@ -5,9 +5,10 @@
  * per-particle terms of core/particles/mf_wall_terms.h:
  *   number density (eq. 4; also the mixed source's density term at r^n),
  *   the mixed source's divergence (eq. 6) with the wall's velocity,
- *   the PPE row: the wall's Laplacian of the continued pressure on the
- *     right-hand side (no wall rows, nothing Dirichlet on the wall),
- *   the pressure gradient (eq. 5) of the continued pressure,
+ *   the PPE row: the walls take the particle's pressure (p_v = p_i: nothing
+ *     of them in the row; no wall rows, nothing Dirichlet on the wall),
+ *   the pressure gradient (eq. 5) of the pressure continued into the wall
+ *     (mps_wall_keep_approach),
  *   the viscous term (eq. 7) with no slip on the face at the wall's velocity,
  *   the collision model against the face.
  * The scene is then built without wall and dummy particles (the driver
@@ -142,6 +143,40 @@ void mps_wall_keep_forces(mps_data *d, const mf_sim *sim)
     memcpy(d->wall->f, d->acc, 3 * sim->p->n_owned * sizeof *d->acc);
 }
 
+/* The wall's velocity at a point, the no-slip weights' average over the
+ * solids within reach (one solid: its velocity). */
+static void wall_velocity(const mf_wall_point *pt, double u[3])
+{
+    for (int a = 0; a < 3; a++)
+        u[a] = pt->s.visc > 0 ? pt->visc_u[a] / pt->s.visc : 0;
+}
+
+/* The acceleration the wall's pressure continues with (mf_wall_gradient_add):
+ * along the face the force acceleration (the hydrostatic part), across it
+ * (u*_i - u_w).n / dt, the rate at which the pressure equation stops the
+ * particle's approach (the source's wall term, mps_wall_divergence). At rest
+ * both are f; a particle sliding along a wall feels no drag from it, one
+ * rushing at it the pressure the equation put there. */
+void mps_wall_keep_approach(mps_data *d, const mf_sim *sim, double dt)
+{
+    struct mps_wall *w = d->wall;
+    for (size_t i = 0; i < sim->p->n_owned; i++) {
+        if (!w->has[i])
+            continue;
+        const mf_wall_point *pt = &w->pt[i];
+        double uw[3], *a = &w->f[3 * i];
+        wall_velocity(pt, uw);
+        const double *n = pt->normal, *u = &sim->p->vel[3 * i];
+        double an = 0, rn = 0;
+        for (int k = 0; k < 3; k++) {
+            an += a[k] * n[k];
+            rn += (u[k] - uw[k]) * n[k];
+        }
+        for (int k = 0; k < 3; k++)
+            a[k] += (rn / dt - an) * n[k];
+    }
+}
+
 void mps_wall_number_density(const mps_data *d, const mf_sim *sim, double *n)
 {
     const struct mps_wall *w = d->wall;
@@ -159,14 +194,6 @@ void mps_wall_viscous(mps_data *d, const mf_sim *sim, double nu)
                                 w->pt[i].visc_u, &d->acc[3 * i]);
 }
 
-/* The wall's velocity at a point, the no-slip weights' average over the
- * solids within reach (one solid: its velocity). */
-static void wall_velocity(const mf_wall_point *pt, double u[3])
-{
-    for (int a = 0; a < 3; a++)
-        u[a] = pt->s.visc > 0 ? pt->visc_u[a] / pt->s.visc : 0;
-}
-
 void mps_wall_divergence(const mps_data *d, const mf_sim *sim, const uint8_t *imask,
                          double *div)
 {
@@ -180,14 +207,6 @@ void mps_wall_divergence(const mps_data *d, const mf_sim *sim, const uint8_t *im
     }
 }
 
-double mps_wall_ppe_rhs(const mps_data *d, size_t i, double rho)
-{
-    const struct mps_wall *w = d->wall;
-    if (!w->has[i])
-        return 0;
-    return mf_wall_ppe_rhs(&w->pt[i].s, &d->k_lap, rho, &w->f[3 * i], w->pt[i].m_a);
-}
-
 void mps_wall_gradient(const mps_data *d, const mf_sim *sim, const double *pressure,
                        const double *phat, double rho)
 {
@@ -195,7 +214,7 @@ void mps_wall_gradient(const mps_data *d, const mf_sim *sim, const double *press
     for (size_t i = 0; i < sim->p->n_owned; i++)
         if (w->has[i])
             mf_wall_gradient_add(&w->pt[i].s, &d->k_grad, pressure[i], phat[i], rho,
-                                 &w->f[3 * i], w->pt[i].t_a, &d->grad[3 * i]);
+                                 &w->f[3 * i], &d->grad[3 * i]);
 }
 
 int mps_wall_collide(mps_data *d, mf_sim *sim, double dt)
