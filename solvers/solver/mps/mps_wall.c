@@ -152,11 +152,16 @@ static void wall_velocity(const mf_wall_point *pt, double u[3])
 }
 
 /* The acceleration the wall's pressure continues with (mf_wall_gradient_add):
- * along the face the force acceleration (the hydrostatic part), across it
- * (u*_i - u_w).n / dt, the rate at which the pressure equation stops the
- * particle's approach (the source's wall term, mps_wall_divergence). At rest
- * both are f; a particle sliding along a wall feels no drag from it, one
- * rushing at it the pressure the equation put there. */
+ * the force acceleration f (the hydrostatic continuation), and across the
+ * face, where the particle approaches the wall faster than f alone would
+ * take it, (u*_i - u_w).n / dt, the rate at which the pressure equation
+ * stops the approach (the source's wall term, mps_wall_divergence). At rest
+ * both are f; a particle sliding along a wall feels no drag from it; one
+ * leaving the wall is not pulled back (as the robust scheme's wall
+ * particles, whose sources are clipped at zero). Measured on the resting
+ * tank (W/H 2, l0 0.01, to 1.5 s, largest speed / sqrt(gH) after 0.5 s):
+ * f alone 0.48, (u* - u_w).n/dt both ways 0.62, this 0.33 (particle walls
+ * 0.22); hydrostatic2D's error 0.0023 (particle walls 0.0023). */
 void mps_wall_keep_approach(mps_data *d, const mf_sim *sim, double dt)
 {
     struct mps_wall *w = d->wall;
@@ -172,8 +177,9 @@ void mps_wall_keep_approach(mps_data *d, const mf_sim *sim, double dt)
             an += a[k] * n[k];
             rn += (u[k] - uw[k]) * n[k];
         }
+        const double push = fmin(rn / dt - an, 0.0); /* a wall pushes, never pulls */
         for (int k = 0; k < 3; k++)
-            a[k] += (rn / dt - an) * n[k];
+            a[k] += push * n[k];
     }
 }
 
