@@ -16,8 +16,8 @@ work=$(mktemp -d)
 echo "wall particles vs wallWeight: savings; $(getconf _NPROCESSORS_ONLN) cores, load $(cut -d' ' -f1-3 /proc/loadavg), $(date -u '+%Y-%m-%d %H:%M UTC')"
 for c in ${CASES:-damBreak2D damBreak3D}; do
     case $c in
-        damBreak2D) src=tutorials/damBreak2D; run_end=0.1; cg_end=0.01 ;;
-        damBreak3D) src=bench/cases/damBreak3D; run_end=0.02; cg_end=0.002 ;;
+        damBreak2D) src=tutorials/damBreak2D; run_end=0.1; cg_end=0.02 ;;
+        damBreak3D) src=bench/cases/damBreak3D; run_end=0.005; cg_end=0.0005 ;;
     esac
     for w in particles wallWeight; do
         d=$work/${c}_$w
