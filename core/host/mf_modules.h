@@ -201,6 +201,13 @@ typedef struct mf_metric_ctx {
     /* validation/metric itself, for entries a parameter table cannot hold
      * (a list: volumeFlux's stations); its other keys are in the settings. */
     const mf_dict *dict;
+    /* Set by the host, so that a metric (a plugin's too) reads snapshots
+     * without the io layer. snapshots: the indices of ctx's snapshots,
+     * ascending (malloc'ed: free *indices). read_snapshot: snapshot `index`
+     * into a zeroed *snap: snap->p (every particle the file holds; free it
+     * with mf_particles_destroy), snap->dim, l0, time and step. */
+    int (*snapshots)(const struct mf_metric_ctx *ctx, int **indices, size_t *n);
+    int (*read_snapshot)(const struct mf_metric_ctx *ctx, int index, mf_sim *snap);
 } mf_metric_ctx;
 
 /* ABI 3 (the kind itself). info.params are the keys of the case's

@@ -64,7 +64,8 @@ int mf_metric_evaluate(mf_registry *reg, const char *case_dir, const char *name,
     mf_module mod = {0};
     if (rc == 0)
         rc = mf_module_prepare(reg, MF_KIND_METRIC, want, d, extra, NULL, &mod);
-    mf_metric_ctx ctx = {case_dir, selected, nselected, out_dir, d};
+    mf_metric_ctx ctx = {case_dir, selected, nselected, out_dir, d, mf_metric_snapshots,
+                         mf_metric_read_snapshot};
     if (rc == 0)
         rc = m->evaluate(mod.settings, &ctx, error);
     if (rc == 0 && used)

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "mf_error.h"
+#include "mf_hdf5.h"
 #include "mf_post.h"
 
 /* Every metric of this layer, in the order `mpsflow modules` lists them. */
@@ -45,5 +46,18 @@ int mf_metric_snapshots(const mf_metric_ctx *ctx, int **indices, size_t *n)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory");
     memcpy(*indices, ctx->selected, ctx->nselected * sizeof **indices);
     *n = ctx->nselected;
+    return 0;
+}
+
+int mf_metric_read_snapshot(const mf_metric_ctx *ctx, int index, mf_sim *snap)
+{
+    char path[4400];
+    mf_snapshot_path(ctx->case_dir, index, path, sizeof path);
+    mf_hdf5_header h;
+    MF_CALL(mf_hdf5_read_header(path, &h));
+    MF_CALL(mf_hdf5_read_snapshot(path, snap));
+    snap->time = h.time;
+    snap->step = h.step;
+    snap->l0 = h.l0;
     return 0;
 }

@@ -19,6 +19,9 @@ void mf_snapshot_path(const char *case_dir, int index, char *path, size_t len);
 /* The snapshots of a metric's context (mf_metric_ctx, mf_modules.h): a
  * malloc'ed copy, free *indices. */
 int mf_metric_snapshots(const mf_metric_ctx *ctx, int **indices, size_t *n);
+/* One snapshot of the case into a zeroed *snap (p, dim, l0, time, step):
+ * what the host puts in mf_metric_ctx.read_snapshot. */
+int mf_metric_read_snapshot(const mf_metric_ctx *ctx, int index, mf_sim *snap);
 
 /* The validation metrics (kind metric, mf_metric_ops): validation/metric
  * names one; mf_post_register_all registers every one. */
