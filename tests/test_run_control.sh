@@ -174,6 +174,10 @@ p=$("$mpsflow" -postProcess -func finalKineticEnergy -time 0.05 -case "$c" |
 e=$(awk '$1 > 0.0499999 && $1 < 0.0500001 {print $2}' "$c/postProcessing/energy/kineticEnergy.dat")
 check "... -time 0.05: the run's own kinetic energy at 0.05 ($p, in the run $e)" \
     "[ -n '$p' ] && [ -n '$e' ] && awk 'BEGIN {d = $p / $e - 1; exit !(d < 1e-5 && d > -1e-5 && $p > 0)}'"
+sed -i '/^libs /d; /^functions/,$d' "$c/system/controlDict" # the library only in validation/metric
+q=$("$mpsflow" -postProcess -func finalKineticEnergy -time 0.05 -case "$c" |
+    sed -n 's/^error finalKineticEnergy = //p')
+check "... the same with the library named only in validation/metric ($q)" "[ -n '$q' ] && [ '$q' = '$p' ]"
 sed -i 's/^density .*/density -1;/' "$c/validation/metric"
 "$mpsflow" validate -case "$c" > "$c/log.bad" 2>&1
 check "the host checks the plugin metric's keys: density -1 refused with file and line" \

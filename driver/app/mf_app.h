@@ -139,6 +139,9 @@ int mf_cmd_validate(mf_registry *reg, const char *case_dir, double *error);
 int mf_metric_evaluate(mf_registry *reg, const char *case_dir, const char *name,
                        const int *selected, size_t nselected, const char *out_dir,
                        double *error, const mf_metric_ops **used);
+/* Load the plugins that DIR/validation/metric names in its `libs` (none
+ * when there is no such file), so that its metric is registered. */
+int mf_app_load_metric_libs(mf_registry *reg, const char *case_dir);
 /* Why output/runSummary says the run did not reach endTime ("" if it did);
  * false when there is no runSummary. Clears the error trace. */
 bool mf_run_status_note(const char *case_dir, char *note, size_t len);

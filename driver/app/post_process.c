@@ -180,6 +180,7 @@ static int replay_one(replay *r, const char *name)
     char fo_names[2048];
     snprintf(fo_names, sizeof fo_names, "%s", mf_error_message());
     mf_error_clear();
+    MF_CALL(mf_app_load_metric_libs(app->reg, app->cs.dir)); /* a plugin's metric */
     if (mf_registry_find(app->reg, MF_KIND_METRIC, name, &found) == 0)
         return replay_metric(r, name);
     char metric_names[2048];

@@ -5,6 +5,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "mf_app.h"
 #include "mf_dictio.h"
@@ -27,6 +28,19 @@ static int metric_extra_keys(const mf_metric_ops *m, const char **keys, size_t c
     }
     keys[n] = NULL;
     return 0;
+}
+
+int mf_app_load_metric_libs(mf_registry *reg, const char *case_dir)
+{
+    char path[4200];
+    snprintf(path, sizeof path, "%s/validation/metric", case_dir);
+    if (access(path, F_OK) != 0)
+        return 0;
+    mf_dict *d = NULL;
+    MF_CALL(mf_dict_parse_file(path, &d));
+    int rc = mf_app_load_function_libs(reg, d);
+    mf_dict_free(d);
+    return rc;
 }
 
 int mf_metric_evaluate(mf_registry *reg, const char *case_dir, const char *name,
