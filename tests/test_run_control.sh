@@ -158,8 +158,7 @@ check "-postProcess of an unknown name lists what there is" \
 # ---- a plugin's metric: finalKineticEnergy of libkineticEnergy.so ---------------------
 fresh energy; c=$dir/energy
 sed -i 's/^\( *interval \).*/\1 1;/' "$c/system/controlDict" # the energy function: every step
-printf 'metric finalKineticEnergy;\nlibs ("libkineticEnergy.so");\ndensity 1000;\n' \
-    > "$c/validation/metric"
+printf 'metric finalKineticEnergy;\nlibs ("libkineticEnergy.so");\n' > "$c/validation/metric"
 "$mpsflow" -case "$c" -endTime 0.1 > "$c/log" 2>&1
 check "mpsflow modules -libs lists the plugin's metric" \
     "'$mpsflow' modules -libs '(libkineticEnergy.so)' | grep -A30 '^metric modules:' |
@@ -178,10 +177,10 @@ sed -i '/^libs /d; /^functions/,$d' "$c/system/controlDict" # the library only i
 q=$("$mpsflow" -postProcess -func finalKineticEnergy -time 0.05 -case "$c" |
     sed -n 's/^error finalKineticEnergy = //p')
 check "... the same with the library named only in validation/metric ($q)" "[ -n '$q' ] && [ '$q' = '$p' ]"
-sed -i 's/^density .*/density -1;/' "$c/validation/metric"
+echo 'relativeTo -1;' >> "$c/validation/metric"
 "$mpsflow" validate -case "$c" > "$c/log.bad" 2>&1
-check "the host checks the plugin metric's keys: density -1 refused with file and line" \
-    "[ \$? -eq 1 ] && grep -q 'validation/metric:3:1: key .density.: -1 is out of range' '$c/log.bad'"
+check "the host checks the plugin metric's keys: relativeTo -1 refused with file and line" \
+    "[ \$? -eq 1 ] && grep -q 'validation/metric:3:1: key .relativeTo.: -1 is out of range' '$c/log.bad'"
 
 # ---- compare and stability pass -endTime and -l0 ------------------------------------
 fresh cmp; c=$dir/cmp

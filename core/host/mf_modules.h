@@ -205,7 +205,8 @@ typedef struct mf_metric_ctx {
      * without the io layer. snapshots: the indices of ctx's snapshots,
      * ascending (malloc'ed: free *indices). read_snapshot: snapshot `index`
      * into a zeroed *snap: snap->p (every particle the file holds; free it
-     * with mf_particles_destroy), snap->dim, l0, time and step. */
+     * with mf_particles_destroy), snap->dim, l0, time, step, and the case's
+     * fluids (snap->fluid, nfluids: mf_sim_particle_mass works on it). */
     int (*snapshots)(const struct mf_metric_ctx *ctx, int **indices, size_t *n);
     int (*read_snapshot)(const struct mf_metric_ctx *ctx, int index, mf_sim *snap);
 } mf_metric_ctx;

@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fluid_snapshots.h"
 #include "mf_error.h"
 #include "mf_hdf5.h"
 #include "mf_post.h"
@@ -55,6 +56,7 @@ int mf_metric_read_snapshot(const mf_metric_ctx *ctx, int index, mf_sim *snap)
     mf_snapshot_path(ctx->case_dir, index, path, sizeof path);
     mf_hdf5_header h;
     MF_CALL(mf_hdf5_read_header(path, &h));
+    MF_CALL(mf_post_read_fluids(ctx->case_dir, snap)); /* masses: mf_sim_particle_mass */
     MF_CALL(mf_hdf5_read_snapshot(path, snap));
     snap->time = h.time;
     snap->step = h.step;

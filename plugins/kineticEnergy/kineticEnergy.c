@@ -8,13 +8,14 @@
  *   functions { energy { type kineticEnergy; libs ("libkineticEnergy.so"); } }
  *
  * It writes postProcessing/<name>/kineticEnergy.dat: time, E = sum m |u|^2 / 2
- * (m = rho l0^d), max speed. On several ranks (-parallel) the sums are
+ * (m = rho l0^d with each particle's own fluid's rho: mf_sim_particle_mass),
+ * max speed. On several ranks (-parallel) the sums are
  * reduced over the ranks and rank 0 writes the file.
  *
  * The metric finalKineticEnergy scores a run by the same E at its last
  * snapshot, for a case that should come to rest (validation/metric):
  *
- *   metric finalKineticEnergy; libs ("libkineticEnergy.so"); density 1000;
+ *   metric finalKineticEnergy; libs ("libkineticEnergy.so");
  *
  * `mpsflow validate` prints E (J; per metre of depth in 2-D) and writes
  * validation/result.csv: time and E of every snapshot. */
@@ -71,12 +72,13 @@ static int ke_create(const void *settings, const mf_sim *sim, const char *out_di
     return 0;
 }
 
-/* E = sum m |u|^2 / 2 over the owned fluid particles of p (m = rho
- * l0^dim) and their largest speed: the one formula of both modules. */
-static void fluid_energy(const mf_particles *p, double rho, double l0, int dim, double *e,
-                         double *umax)
+/* E = sum m |u|^2 / 2 over the owned fluid particles of sim (m = rho l0^d
+ * of each particle's own fluid: mf_sim_particle_mass) and their largest
+ * speed: the one formula of both modules. */
+static void fluid_energy(const mf_sim *sim, double *e, double *umax)
 {
-    const double mass = rho * pow(l0, dim);
+    const mf_particles *p = sim->p;
+    const int fluid_field = mf_particles_field_index(p, "FluidId");
     *e = 0;
     *umax = 0;
     for (size_t i = 0; i < p->n_owned; i++) {
@@ -84,7 +86,7 @@ static void fluid_energy(const mf_particles *p, double rho, double l0, int dim, 
             continue;
         const double *v = &p->vel[3 * i];
         double u2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
-        *e += 0.5 * mass * u2;
+        *e += 0.5 * mf_sim_particle_mass(sim, fluid_field, i) * u2;
         if (u2 > *umax * *umax)
             *umax = sqrt(u2);
     }
@@ -96,7 +98,7 @@ static int ke_execute(void *data, const mf_sim *sim)
     if (sim->step % d->s.interval != 0)
         return 0;
     double e, umax;
-    fluid_energy(sim->p, sim->fluid[0].rho, sim->l0, sim->dim, &e, &umax);
+    fluid_energy(sim, &e, &umax);
     mf_parallel_sum(sim->par, &e, 1);
     mf_parallel_max(sim->par, &umax, 1);
     if (d->out)
@@ -125,14 +127,14 @@ static const mf_function_object_ops kinetic_energy_ops = {
 /* ---- the metric finalKineticEnergy ---------------------------------------- */
 typedef struct final_settings {
     const char *metric;
-    double rho;
+    double relative_to;
 } final_settings;
 
 static const mf_param final_params[] = {
     {"metric", MF_PARAM_WORD, NULL, MF_NO_RANGE, NULL, offsetof(final_settings, metric),
      "finalKineticEnergy"},
-    {"density", MF_PARAM_SCALAR, NULL, 1e-9, 1e9, NULL, offsetof(final_settings, rho),
-     "rho of the fluid, kg/m^3 (a particle's mass is rho l0^d)"},
+    {"relativeTo", MF_PARAM_SCALAR, "0", 0, 1e30, NULL, offsetof(final_settings, relative_to),
+     "J: the error is E / relativeTo (0: E itself, J)"},
 };
 
 /* E of every snapshot of ctx into result.csv; *error: E at the last one. */
@@ -158,9 +160,9 @@ static int final_evaluate(const void *settings, const mf_metric_ctx *ctx, double
         rc = ctx->read_snapshot(ctx, idx[k], &snap);
         double e = 0, umax = 0;
         if (rc == 0) {
-            fluid_energy(snap.p, s->rho, snap.l0, snap.dim, &e, &umax);
+            fluid_energy(&snap, &e, &umax);
             fprintf(out, "%.10g,%.10g\n", snap.time, e);
-            *error = e;
+            *error = s->relative_to > 0 ? e / s->relative_to : e;
         }
         mf_particles_destroy(snap.p);
     }
