@@ -63,12 +63,12 @@ int mf_metric_evaluate(mf_registry *reg, const char *case_dir, const char *name,
         rc = MF_ERROR(MF_ERR_INPUT, "%s: %s",
                       name ? "-func" : mf_loc_str(e->loc, where, sizeof where),
                       mf_error_message());
-    }
-    else if (rc == 0 && strcmp(want, in_file) != 0)
+    } else if (rc == 0 && strcmp(want, in_file) != 0) {
         rc = MF_ERROR(MF_ERR_INPUT,
                       "%s names the metric '%s'; '%s' needs its own settings there "
                       "(metric %s; ...)",
                       path, in_file, want, want);
+    }
     const mf_metric_ops *m = (const mf_metric_ops *)info;
     if (rc == 0 && !m->evaluate)
         rc = MF_ERROR(MF_ERR_INPUT, "metric '%s' has no evaluate", want);
