@@ -182,7 +182,7 @@ int mf_cmd_modules(mf_registry *reg, const char *name)
         printf("\n");
         return 0;
     }
-    if (mf_dict_tables_print(name, stdout))
+    if (mf_dict_tables_print(reg, name, stdout))
         return 0;
     const mf_module_info *m = mf_registry_lookup_any(reg, name);
     if (!m) {
@@ -419,9 +419,9 @@ int main(int argc, char **argv)
     else if (rc == 0 && !strcmp(command, "reference") && root)
         rc = mf_cmd_reference(app.reg, module_name);
     else if (rc == 0 && !strcmp(command, "validate") && root)
-        rc = mf_cmd_validate(app.opt.case_dir, &error);
+        rc = mf_cmd_validate(app.reg, app.opt.case_dir, &error);
     else if (rc == 0 && !strcmp(command, "compare"))
-        rc = mf_cmd_compare(&app.opt);
+        rc = mf_cmd_compare(app.reg, &app.opt);
     else if (rc == 0 && !strcmp(command, "stability"))
         rc = mf_cmd_stability(&app.opt);
     /* A failure every rank agreed on is printed once; one that a rank met
