@@ -14,6 +14,7 @@ extern const mf_metric mf_metric_sloshing;         /* metric_sloshing.c */
 extern const mf_metric mf_metric_containment;      /* metric_containment.c */
 extern const mf_metric mf_metric_resting_tank;     /* metric_resting_tank.c */
 extern const mf_metric mf_metric_target_fraction;  /* metric_target_fraction.c */
+extern const mf_metric mf_metric_floating;         /* metric_floating.c */
 /* metric_droplet.c: the multi-fluid cases */
 extern const mf_metric mf_metric_laplace, mf_metric_oscillation, mf_metric_layering,
     mf_metric_rayleigh_taylor, mf_metric_fluid_surge_front;
@@ -34,6 +35,7 @@ const mf_metric *const mf_metrics[] = {
     &mf_metric_containment,
     &mf_metric_resting_tank,
     &mf_metric_target_fraction,
+    &mf_metric_floating,
 };
 const size_t mf_nmetrics = sizeof mf_metrics / sizeof mf_metrics[0];
 
