@@ -18,6 +18,8 @@
  *              MOMENTUM_TOL = 1e-8 (10 ulp of the CSV's digits; a wrong sign,
  *              factor or one-step lag of the exchange is an error of order
  *              the impulse exchanged, 0.4 P(0) here);
+ *   snapshot   the last snapshot holds the body's state (/RigidBodies/body):
+ *              its Velocity is the CSV's at that time (to the CSV's digits);
  *   at rest    the same body with the blob at rest stays at rest (no force
  *              from nothing): |v_b| below 1e-6 m/s.
  *
@@ -26,6 +28,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include <hdf5.h>
 
 #include "case_util.h"
 #include "mf_test.h"
@@ -120,6 +124,24 @@ static void track_free(track *tr)
     free(tr->f);
 }
 
+/* Attribute `name` (n doubles) of /RigidBodies/<body> in snapshot `path`. */
+static int body_attribute(const char *path, const char *body, const char *name, double *v)
+{
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    if (f < 0)
+        return -1;
+    char obj[256];
+    snprintf(obj, sizeof obj, "/RigidBodies/%s", body);
+    int rc = -1;
+    hid_t a = H5Aopen_by_name(f, obj, name, H5P_DEFAULT, H5P_DEFAULT);
+    if (a >= 0) {
+        rc = H5Aread(a, H5T_NATIVE_DOUBLE, v) < 0 ? -1 : 0;
+        H5Aclose(a);
+    }
+    H5Fclose(f);
+    return rc;
+}
+
 static bool run(tc_case *c, const char *what)
 {
     int status = tc_case_run(c, NULL, NULL);
@@ -184,6 +206,16 @@ static void check_momentum(const char *exe)
                       "momentum: t = %g: |P - P(0)| = %g above %g P(0) (the impulse exchanged: "
                       "%g)", h.time, err, MOMENTUM_TOL, impulse);
             checked++;
+        }
+        if (s.n > 0) {
+            char path[1024];
+            tc_snapshot_path(c.dir, s.index[s.n - 1], path, sizeof path);
+            double v[3] = {NAN, NAN, NAN};
+            CHECK_OK(body_attribute(path, "body", "Velocity", v));
+            const double vl = tr.v[2 * (tr.n - 1)];
+            printf("snapshot: /RigidBodies/body Velocity (%.9g %.9g), the CSV's last row %.9g\n",
+                   v[0], v[1], vl);
+            CHECK(fabs(v[0] - vl) <= 1e-8 * fabs(vl) && fabs(v[1]) < 1e-12);
         }
         tc_snapshots_free(&s);
         CHECK_MSG(checked >= 5, "momentum: only %zu snapshots matched the body's rows", checked);

@@ -74,7 +74,7 @@ int mf_bodies_open_output(mf_walls *ws, const char *post_dir, double t);
  * centre of mass), committed, and the pending impulses J^n, H^n. */
 typedef struct mf_body_momentum {
     double mass;
-    double centre[3], velocity[3], omega[3];
+    double centre[3], rotation[9], velocity[3], omega[3];
     double momentum[3], angular[3];
     double impulse[3], angular_impulse[3];
 } mf_body_momentum;

@@ -401,6 +401,7 @@ void mf_body_get(const mf_wall *w, mf_body_momentum *out)
     if (!b)
         return;
     out->mass = b->mass;
+    memcpy(out->rotation, b->R, sizeof out->rotation);
     for (int c = 0; c < 3; c++) {
         out->centre[c] = b->x[c];
         out->velocity[c] = b->v[c];
