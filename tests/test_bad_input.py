@@ -513,7 +513,7 @@ EXPECTED.update({
     'validate without metric':
         "--> mpsflow FATAL ERROR: cannot open dictionary file '{case}/validation/metric' (No such file or directory)",
     'unknown metric':
-        "--> mpsflow FATAL ERROR: {case}/validation/metric: unknown metric 'surge'; known: surgeFront, hydrostaticPressure, scalarAdvection, volumeFlux, laplacePressure, oscillationPeriod, layering, rayleighTaylor, fluidSurgeFront, poiseuille, couette, sloshingPeriod, containment, restingTank, targetFraction",
+        "--> mpsflow FATAL ERROR: {case}/validation/metric: unknown metric 'surge'; known: surgeFront, hydrostaticPressure, scalarAdvection, volumeFlux, laplacePressure, oscillationPeriod, layering, rayleighTaylor, fluidSurgeFront, poiseuille, couette, sloshingPeriod, containment, restingTank, targetFraction, floatingDraft",
     'restart without snapshots':
         '--> mpsflow FATAL ERROR: no snapshot to restart from in {case}/output (run without -latestTime first)',
     'compareDict unknown key':
