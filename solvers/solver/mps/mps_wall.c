@@ -24,6 +24,7 @@
 #include <string.h>
 
 #include "mf_alloc.h"
+#include "mf_bodies.h"
 #include "mf_error.h"
 #include "mf_operators.h"
 #include "mf_wall_terms.h"
@@ -95,6 +96,8 @@ int mps_wall_create(mps_data *d, mf_sim *sim, const mf_dict *solver_dict)
         why = "the implicit viscosity has no wall term yet (set viscosity explicit;)";
     else if (sim->par)
         why = "not on several ranks yet (run it serially)";
+    else if (mf_bodies_count(sim->walls) > 0)
+        why = "rigid bodies take their forces from their wall particles (mps_bodies.c)";
     else if (!sim->wall_weight)
         why = "the scene was built with wall particles (the driver builds it without them when "
               "MPSCoeffs sets wall wallWeight;)";
