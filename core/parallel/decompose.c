@@ -362,11 +362,18 @@ int mf_parallel_rebalance(mf_parallel *par, mf_particles *p, bool force, const u
     if (p->n != p->n_owned)
         return MF_ERROR(MF_ERR_INTERNAL, "mf_parallel_rebalance: drop the halo first");
     const double imbalance = mf_parallel_imbalance(par, p, walls);
-    if (par->partitioned && !force && imbalance <= par->s.imbalance_threshold)
+    /* The threshold, or when the last partition could not get below it (a
+     * small scene's lattice planes, two criteria), the threshold's margin
+     * over what it achieved: otherwise every step would partition anew. */
+    const double limit = fmax(par->s.imbalance_threshold,
+                              par->s.imbalance_threshold * par->stats.imbalance_after);
+    if (par->partitioned && !force && imbalance <= limit)
         return 0;
     par->stats.imbalance_before = imbalance;
     MF_CALL(partition(par, p, walls));
-    mf_parallel_imbalance(par, p, NULL); /* the walls' marks moved with the particles */
+    /* The walls' marks moved with the particles: the caller may measure
+     * again with its new marks. */
+    par->stats.imbalance_after = mf_parallel_imbalance(par, p, NULL);
     return 0;
 }
 

@@ -74,6 +74,9 @@ typedef struct mf_parallel_stats {
                                of the two criteria's when multi_criteria) */
     double imbalance_rows;  /* of the pressure rows alone (1 without multi_criteria) */
     double imbalance_before; /* the same before the last new partition */
+    double imbalance_after; /* right after it: what the partition could achieve (a
+                               caller that weighs by the pressure walls sets it
+                               with theirs) */
     double t_migrate, t_rebalance, t_halo; /* wall seconds */
     double t_halo_wait;     /* of t_halo: in the first collective call of a build,
                                where a rank waits for the slowest (load imbalance) */
