@@ -247,6 +247,10 @@ static double wall_energy(const mf_sim *sim)
         const double u = mf_walls_max_speed(sim->walls, p);
         u2 = u * u;
     }
+    /* Over the ranks, as the other energies: a rank without the lid's
+     * particles would otherwise see no wall energy and fire alone. */
+    mf_parallel_sum(sim->par, &mass, 1);
+    mf_parallel_max(sim->par, &u2, 1);
     return 0.5 * mass * u2;
 }
 
