@@ -90,6 +90,11 @@ void mf_number_density_rate(const mf_pairs *v, const double *u, const uint8_t *i
  * the fluid (free-surface detection by neighbour asymmetry). */
 void mf_neighbour_asymmetry(const mf_pairs *v, const mf_kernel *k, const uint8_t *imask,
                             const uint8_t *jmask, double *out);
+/* mf_number_density(v, imask, NULL, n) and, for the rows also in amask,
+ * mf_neighbour_asymmetry(v, k, amask, NULL, asym), in one pass over the
+ * pairs (the same sums, bit for bit); amask within imask. */
+void mf_number_density_asymmetry(const mf_pairs *v, const mf_kernel *k, const uint8_t *imask,
+                                 const uint8_t *amask, double *n, double *asym);
 /* (d/n0) sum_j r_ij w_ij/|r_ij|^2 (3 per particle): the gradient of the
  * particle concentration in MPS form (eq. 5 on C = 1 without the f_i term),
  * pointing to where neighbours crowd (particle shifting). */

@@ -587,6 +587,50 @@ void mf_neighbour_asymmetry(const mf_pairs *v, const mf_kernel *k, const uint8_t
     mf_pairs_each(v, imask, unit_row, &c);
 }
 
+/* The number density and, in the same pass over each row, the asymmetry:
+ * each sum gets the pairs in the order the two operators alone give them,
+ * so the results are theirs bit for bit. */
+typedef struct {
+    dir_ctx dir;              /* the asymmetry's (jmask NULL) */
+    const uint8_t *amask;     /* rows that also want the asymmetry */
+    double *n;
+} nd_asym_ctx;
+
+typedef struct {
+    double n;
+    double a[3];
+} nd_asym_acc;
+
+static inline bool nd_asym_pair(void *acc, const void *ctx, const mf_pair *pr)
+{
+    const nd_asym_ctx *c = ctx;
+    nd_asym_acc *s = acc;
+    s->n += mf_weight(pr->len, c->dir.v->radius);
+    return unit_pair(s->a, &c->dir, pr);
+}
+
+static void nd_asym_row(const void *ctx, size_t i)
+{
+    const nd_asym_ctx *c = ctx;
+    if (!c->amask[i]) {
+        const nd_ctx nd = {c->dir.v, NULL, c->n};
+        nd_row(&nd, i);
+        return;
+    }
+    nd_asym_acc s = {0.0, {0.0, 0.0, 0.0}};
+    mf_pairs_row(c->dir.v, i, NULL, nd_asym_pair, c, &s);
+    c->n[i] = s.n;
+    for (int q = 0; q < 3; q++)
+        c->dir.out[3 * i + q] = c->dir.coef * s.a[q];
+}
+
+void mf_number_density_asymmetry(const mf_pairs *v, const mf_kernel *k, const uint8_t *imask,
+                                 const uint8_t *amask, double *n, double *asym)
+{
+    const nd_asym_ctx c = {{v, NULL, 1.0 / k->n0, asym}, amask, n};
+    mf_pairs_each(v, imask, nd_asym_row, &c);
+}
+
 void mf_concentration_gradient(const mf_pairs *v, const mf_kernel *k, const uint8_t *imask,
                                const uint8_t *jmask, double *out)
 {

@@ -182,13 +182,11 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
  * surface (p = 0); its source is clipped at zero (mps_ppe.c): a wall pushes
  * and does not pull. Into d->flag_work: 1 on the surface. */
 #define MPS_SPARSE 0.8
-static int detect_by_asymmetry(mps_data *d, mf_sim *sim, const mf_pairs *vnd)
+static int detect_by_asymmetry(mps_data *d, mf_sim *sim)
 {
     mf_particles *p = sim->p;
-    MF_CALL(mps_scheme_reserve(d, p->n));
     const double *n = mf_particles_fd(p, d->f_number_density);
-    double *F = d->work;
-    mf_neighbour_asymmetry(vnd, &d->k_nd, d->is_fluid, NULL, F);
+    const double *F = d->work; /* the asymmetry of the fluid (mps_surface_phase) */
     mf_pairs vg;
     MF_CALL(mps_pairs(d, sim, d->h_grad, &vg));
     const double thr = d->s.asymmetry * d->k_nd.asym_flat, n0 = d->k_nd.n0;
@@ -219,10 +217,15 @@ int mps_surface_phase(mps_data *d, mf_sim *sim)
     int32_t *flags = mf_particles_fi(p, d->f_flags);
     mf_pairs v;
     MF_CALL(mps_pairs(d, sim, d->h_nd, &v));
-    mf_number_density(&v, d->not_dummy, NULL, n);
     const double n0 = d->k_nd.n0;
-    if (d->sc.detection == MPS_DETECT_ASYMMETRY)
-        MF_CALL(detect_by_asymmetry(d, sim, &v));
+    if (d->sc.detection == MPS_DETECT_ASYMMETRY) {
+        /* n* of the particles and the fluid's asymmetry in one pass */
+        MF_CALL(mps_scheme_reserve(d, p->n));
+        mf_number_density_asymmetry(&v, &d->k_nd, d->not_dummy, d->is_fluid, n, d->work);
+        MF_CALL(detect_by_asymmetry(d, sim));
+    } else {
+        mf_number_density(&v, d->not_dummy, NULL, n);
+    }
     for (size_t i = 0; i < p->n_owned; i++) {
         bool surface = d->sc.detection == MPS_DETECT_ASYMMETRY
                            ? d->flag_work[i]
