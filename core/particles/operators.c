@@ -448,6 +448,56 @@ void mf_laplacian_add(const mf_pairs *v, const mf_kernel *k, const double *f, do
     mf_pairs_each(v, imask, lap3_add_row, &c);
 }
 
+/* The number density and, in the same pass over each row, the viscous
+ * term: each sum gets the pairs in the order the two operators alone give
+ * them (a pair of zero weight adds nothing to either), so the results are
+ * theirs bit for bit. */
+typedef struct {
+    lap_ctx lap;              /* mf_laplacian_add's (jmask NULL) */
+    const uint8_t *lmask;     /* rows that also want the Laplacian */
+    double *n;
+} lap_nd_ctx;
+
+typedef struct {
+    double a[3];
+    double n;
+} lap_nd_acc;
+
+static inline bool lap3_nd_pair(void *acc, const void *ctx, const mf_pair *pr)
+{
+    const lap_nd_ctx *c = ctx;
+    lap_nd_acc *s = acc;
+    s->n += mf_weight(pr->len, c->lap.v->radius);
+    return lap3_pair(s->a, &c->lap, pr);
+}
+
+static void lap3_add_nd_row(const void *ctx, size_t i)
+{
+    const lap_nd_ctx *c = ctx;
+    if (!c->lmask[i]) {
+        const nd_ctx nd = {c->lap.v, NULL, c->n};
+        nd_row(&nd, i);
+        return;
+    }
+    lap_nd_acc s = {{0.0, 0.0, 0.0}, 0.0};
+    mf_pairs_row(c->lap.v, i, NULL, lap3_nd_pair, c, &s);
+    c->n[i] = s.n;
+    for (int q = 0; q < 3; q++) {
+        const double lap = c->lap.coef * s.a[q];
+        c->lap.out[3 * i + q] += c->lap.scale * lap;
+    }
+}
+
+void mf_laplacian_add_number_density(const mf_pairs *v, const mf_kernel *k, const double *f,
+                                     double scale, const uint8_t *imask, const uint8_t *lmask,
+                                     double *out, double *n)
+{
+    const lap_nd_ctx c = {{.v = v, .jmask = NULL, .f = f, .ncomp = 3, .coef = lap_coef(k),
+                           .scale = scale, .out = out},
+                          lmask, n};
+    mf_pairs_each(v, imask, lap3_add_nd_row, &c);
+}
+
 void mf_laplacian_mu(const mf_pairs *v, const mf_kernel *k, const double *f, const double *mu,
                      int mu_average, const uint8_t *mu_mask, const double *rho,
                      const uint8_t *imask, double *out)

@@ -137,7 +137,15 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
     mf_particles *p = sim->p;
     const double nu = sim->fluid[0].nu;
     retry_scale(d, sim, dt);
-    MF_CALL(mps_source_start(d, sim)); /* what the scheme's source needs of r^n, u^n */
+    /* The mixed source's n at r^n rides in the viscous term's pass when both
+     * are eq. 3's sums over the same pairs (the same values, one pass). */
+    const bool nd_with_viscosity = !d->visc && !d->mu && nu > 0 &&
+                                   d->sc.laplacian == MPS_LAPLACIAN_PAPER &&
+                                   d->sc.source == MPS_SOURCE_MIXED && d->k_nd.re == d->k_lap.re;
+    if (nd_with_viscosity)
+        MF_CALL(mps_scheme_reserve(d, p->n));
+    else
+        MF_CALL(mps_source_start(d, sim)); /* what the scheme's source needs of r^n, u^n */
     memset(d->acc, 0, 3 * p->n * sizeof *d->acc);
     MF_CALL(mf_force_accumulate(sim, d->acc));
     if (d->visc) { /* viscosity implicit: u* = (I - dt nu lap)^-1 (u + dt a), r* = r + dt u* */
@@ -150,6 +158,9 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
         if (d->mu) /* eq. 27: each pair through mu_ij, walls and dummies with mu_i */
             mf_laplacian_mu(&v, &d->k_lap, p->vel, d->mu, d->mu_average, d->is_fluid, d->rho,
                             d->is_fluid, d->acc);
+        else if (nd_with_viscosity)
+            mf_laplacian_add_number_density(&v, &d->k_lap, p->vel, nu, d->not_dummy, d->is_fluid,
+                                            d->acc, d->n_start);
         else
             mf_laplacian_add(&v, &d->k_lap, p->vel, nu, d->is_fluid, NULL, d->acc);
     }
