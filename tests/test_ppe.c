@@ -206,8 +206,8 @@ static void check_matrix(world *w, bool variable_density, const char *what)
         }
         const double rho0 = sim->fluid[0].rho;
         const double want = variable_density
-                                ? d->s.relaxation / (dt * dt) * (nd[i] - n0) / n0 + known
-                                : d->s.relaxation * rho0 / (dt * dt) * (nd[i] - n0) / n0;
+                                ? d->sc.relaxation / (dt * dt) * (nd[i] - n0) / n0 + known
+                                : d->sc.relaxation * rho0 / (dt * dt) * (nd[i] - n0) / n0;
         bad_rhs += !(fabs(d->rhs[r] - want) <= 1e-9 * (fabs(want) + rho0 / (dt * dt) * 1e-9));
     }
     CHECK_MSG(unknowns == A->nrows && unknowns > 0, "%s: %zu unknowns, %zu rows", what,

@@ -6,7 +6,8 @@
  *   functions { energy { type kineticEnergy; libs ("libkineticEnergy.so"); } }
  *
  * Writes postProcessing/<name>/kineticEnergy.dat: time, E = sum m |u|^2 / 2
- * per unit mass (m = rho l0^d), max speed. On several ranks (-parallel) the
+ * (m = rho l0^d with each particle's own fluid's rho: mf_sim_particle_mass),
+ * max speed. On several ranks (-parallel) the
  * sums are reduced over the ranks and rank 0 writes the file. */
 #include <errno.h>
 #include <math.h>
@@ -67,14 +68,14 @@ static int ke_execute(void *data, const mf_sim *sim)
     if (sim->step % d->s.interval != 0)
         return 0;
     const mf_particles *p = sim->p;
-    const double mass = sim->fluid[0].rho * pow(sim->l0, sim->dim);
+    const int fluid_field = mf_particles_field_index(p, "FluidId");
     double e = 0, umax = 0;
     for (size_t i = 0; i < p->n_owned; i++) {
         if (p->kind[i] != MF_FLUID)
             continue;
         const double *v = &p->vel[3 * i];
         double u2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
-        e += 0.5 * mass * u2;
+        e += 0.5 * mf_sim_particle_mass(sim, fluid_field, i) * u2;
         if (u2 > umax * umax)
             umax = sqrt(u2);
     }

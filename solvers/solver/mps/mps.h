@@ -29,13 +29,13 @@ typedef struct mps_settings {
     double re_gradient;
     double re_laplacian;
     double beta;              /* eq. 18: free surface when n* < beta n0 */
-    double relaxation;        /* factor on the PPE source term (1: the paper) */
+    double relaxation;        /* factor on the PPE source term (0: the scheme's) */
     double compressibility;   /* 1/Pa; adds rho c / dt^2 to the diagonal (0: off) */
     bool clip_negative_pressure;
     bool gradient_pmin;       /* eq. 5 with p_min (Koshizuka et al. 1998) */
     /* The scheme (mps_scheme.c): a named set of the five choices below,
      * each of which a case may set apart ("scheme": the scheme's). */
-    const char *scheme;       /* paper | robust */
+    const char *scheme;       /* paper | robust | stabilised */
     const char *source;       /* PPE source: density | mixed | higherOrder | errorCompensating */
     const char *gradient;     /* pressure gradient: paper | corrected | leastSquares */
     const char *laplacian;    /* paper | higherOrder | leastSquares */
@@ -80,6 +80,7 @@ typedef struct mps_scheme {
     mps_shift_kind shifting;
     mps_detection_kind detection;
     bool collision;
+    double relaxation; /* factor on the eq. 14 source (1: the paper) */
 } mps_scheme;
 
 typedef struct mps_data {
@@ -174,9 +175,10 @@ extern const char *const mps_scheme_choices[], *const mps_source_choices[],
 /* The entries of that table, for a solver whose settings embed an
  * mps_settings (the multi-fluid solver): OFF(field) is the offset of the
  * embedded field in the embedding struct; SCHEME the solver's default scheme
- * (docs/topics/schemes.md: MPS robust; MAFL and multiFluid paper, where
- * robust was measured to lose MAFL points and to break the droplets'
- * free-surface pressure). One list, three tables.
+ * (docs/topics/schemes.md: MPS robust; MAFL paper, where robust was
+ * measured to lose MAFL points; multiFluid stabilised, where paper stopped
+ * three of its five tutorials and robust broke the droplets' free-surface
+ * pressure). One list, three tables.
  * reNumberDensity 3.1 rather than Koshizuka & Oka's 2.1: on hydrostatic2D
  * the resting pressure comes out 7.5% high at the bottom with 2.1 and within
  * 1% with 3.1 (README, "Choices measured"). */
@@ -190,8 +192,8 @@ extern const char *const mps_scheme_choices[], *const mps_source_choices[],
      "radius of the Laplacian (viscosity, pressure equation), in l0"},                          \
     {"beta", MF_PARAM_SCALAR, "0.97", 0.5, 1.0, NULL, OFF(beta),                                \
      "free surface where n* < beta n0 (eq. 18)"},                                               \
-    {"relaxation", MF_PARAM_SCALAR, "1", 0.01, 1, NULL, OFF(relaxation),                        \
-     "factor on the source term of the pressure equation (1: the paper)"},                      \
+    {"relaxation", MF_PARAM_SCALAR, "0", 0, 1, NULL, OFF(relaxation),                           \
+     "factor on the eq. 14 source term (1: the paper; 0: the scheme's, 0.2 for stabilised)"},   \
     {"compressibility", MF_PARAM_SCALAR, "0", 0, 1e-3, NULL,                                    \
      OFF(compressibility),                                                                      \
      "artificial compressibility, 1/Pa (adds rho c/dt^2 to the diagonal; 0: off)"},             \
@@ -202,7 +204,8 @@ extern const char *const mps_scheme_choices[], *const mps_source_choices[],
      "pressure gradient with p_min of the neighbourhood (eq. 5 note)"},                         \
     {"scheme", MF_PARAM_WORD, SCHEME, MF_NO_RANGE, mps_scheme_choices, OFF(scheme),             \
      "the scheme: the defaults of source, gradient, laplacian, shifting, surfaceDetection "      \
-     "and collision (paper: eqs. 5, 7, 14, 18 as printed)"},                                     \
+     "and collision (paper: eqs. 5, 7, 14, 18 as printed; robust: mixed source, asymmetry "     \
+     "surface test, collision; stabilised: paper with relaxation 0.2 and collision)"},           \
     {"source", MF_PARAM_WORD, "scheme", MF_NO_RANGE, mps_source_choices, OFF(source),          \
      "source term of the pressure equation: density (eq. 14), mixed (Tanaka & Masunaga 2010), " \
      "higherOrder (Khayyer & Gotoh 2009), errorCompensating (Khayyer & Gotoh 2011)"},           \

@@ -213,10 +213,10 @@ static bool ppe_row(const void *ctx, size_t i, size_t r)
     double *val = d->A.val;
     if (c->rho_p) {
         val[diag] = sum + d->s.compressibility / dt2;
-        d->rhs[r] = c->src ? c->src[i] : d->s.relaxation / dt2 * dn / c->n0;
+        d->rhs[r] = c->src ? c->src[i] : d->sc.relaxation / dt2 * dn / c->n0;
     } else {
         val[diag] = sum + d->s.compressibility * c->rho / dt2;
-        d->rhs[r] = c->src ? c->rho * c->src[i] : d->s.relaxation * c->rho / dt2 * dn / c->n0;
+        d->rhs[r] = c->src ? c->rho * c->src[i] : d->sc.relaxation * c->rho / dt2 * dn / c->n0;
     }
     if (c->walls_push && !d->is_fluid[i] && d->rhs[r] < 0)
         d->rhs[r] = 0; /* surfaceDetection asymmetry: a wall pushes, never pulls */

@@ -10,7 +10,7 @@ static const char *const averages[] = {"arithmetic", "harmonic", NULL};
 #define OWN(field) offsetof(multifluid_settings, field)
 
 const mf_param multifluid_params[MULTIFLUID_NPARAMS] = {
-    MPS_PARAM_ENTRIES(MPS_OFFSET, "paper")
+    MPS_PARAM_ENTRIES(MPS_OFFSET, "stabilised")
     {"densityRatioThreshold", MF_PARAM_SCALAR, "10", 1, 1e12, NULL, OWN(ratio_threshold),
      "largest/smallest density below which one pressure solve per step is made; above it "
      "the iterative two-step solve (light fluid, then heavy fluid)"},
