@@ -1,7 +1,8 @@
 /* test_registry.c: the module registry and plugin loading; a module table
  * of an older ABI version (read only as far as it goes, its missing slots
- * NULL). argv[1]: the folder holding libkineticEnergy.so (the build's
- * plugins/). */
+ * NULL); a plugin built for version 2. argv[1]: the folder holding
+ * libkineticEnergy.so (the build's plugins/); argv[2]: the one holding
+ * libabi2Plugin.so (the build's tests/). */
 #include <math.h>
 #include <string.h>
 #include <sys/mman.h>
@@ -117,6 +118,56 @@ static void test_plugin(const char *plugin_dir)
     const mf_module_info *m = NULL;
     CHECK_OK(mf_registry_find(reg, MF_KIND_FUNCTION_OBJECT, "kineticEnergy", &m));
     CHECK(m && m->abi_version == MF_ABI_VERSION);
+    /* The same library adds a metric. */
+    CHECK_OK(mf_registry_find(reg, MF_KIND_METRIC, "finalKineticEnergy", &m));
+    CHECK(m && m->kind == MF_KIND_METRIC && ((const mf_metric_ops *)m)->evaluate);
+    mf_registry_destroy(reg);
+}
+
+/* ---- a plugin built for ABI version 2 ------------------------------------ */
+/* Version 3 added the metric kind and no slot: a version-2 force is taken
+ * as it is (its table copied into the current layout, every slot kept),
+ * and a "version-2 metric", a kind its headers did not have, is refused
+ * with a message that says so. */
+static void test_abi2_plugin(const char *dir)
+{
+    CHECK(MF_ABI_VERSION == 3);
+    CHECK(mf_ops_size(MF_KIND_METRIC, 2) == 0);
+    CHECK(mf_ops_size(MF_KIND_METRIC, 3) == sizeof(mf_metric_ops));
+    CHECK(mf_ops_size(MF_KIND_FORCE, 2) == sizeof(mf_force_ops));
+    mf_registry *reg = NULL;
+    CHECK_OK(mf_registry_create(&reg));
+    mf_registry_set_plugin_dir(reg, dir);
+    CHECK(mf_registry_load_plugin(reg, "abi2Plugin") == MF_ERR_INPUT);
+    printf("version-2 metric: %s\n", mf_error_message());
+    CHECK(strstr(mf_error_message(), "'abi2Metric' is a metric module, a kind added after the "
+                                     "module ABI version 2") != NULL);
+    mf_error_clear();
+    const mf_module_info *m = NULL;
+    CHECK_OK(mf_registry_find(reg, MF_KIND_FORCE, "abi2Push", &m));
+    const mf_force_ops *ops = (const mf_force_ops *)m;
+    CHECK(m && m->abi_version == 2 && m->nparams == 1 && ops->create && ops->accumulate &&
+          ops->destroy && !ops->stable_dt && ops->flags == 0);
+    CHECK(mf_registry_find(reg, MF_KIND_METRIC, "abi2Metric", &m) == MF_ERR_INPUT);
+    mf_error_clear();
+    /* Created from a dictionary and called like any force. */
+    mf_module mod;
+    mf_dict *d = NULL;
+    CHECK_OK(mf_dict_parse_string("a 2.5;", 6, "test", &d));
+    CHECK_OK(mf_module_prepare(reg, MF_KIND_FORCE, "abi2Push", d, NULL, NULL, &mod));
+    mf_sim sim;
+    memset(&sim, 0, sizeof sim);
+    CHECK_OK(mf_particles_create(2, 2, &sim.p));
+    const double x0[3] = {0, 0, 0}, v[3] = {0, 0, 0};
+    CHECK_OK(mf_particles_add(sim.p, MF_FLUID, x0, v, NULL));
+    double acc[3] = {0};
+    CHECK_OK(ops->create(mod.settings, &sim, &mod.data));
+    CHECK_OK(ops->accumulate(mod.data, &sim, acc));
+    CHECK(acc[0] == 2.5 && acc[1] == 0);
+    ops->destroy(mod.data);
+    mf_module_release(&mod);
+    mf_dict_free(d);
+    mf_particles_destroy(sim.p);
     mf_registry_destroy(reg);
 }
 
@@ -225,13 +276,14 @@ static void test_older_abi(void)
 
 int main(int argc, char **argv)
 {
-    if (argc < 2) {
-        fprintf(stderr, "usage: test_registry PLUGIN_DIR\n");
+    if (argc < 3) {
+        fprintf(stderr, "usage: test_registry PLUGIN_DIR TEST_PLUGIN_DIR\n");
         return 2;
     }
     test_builtins_and_lookup();
     test_refusals();
     test_older_abi();
     test_plugin(argv[1]);
+    test_abi2_plugin(argv[2]);
     return mf_test_summary("registry");
 }

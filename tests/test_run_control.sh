@@ -5,7 +5,7 @@
 # during a run, a broken edit survived); purgeWrite; a new run over an old
 # output/ refused, -overwrite; restarts at another l0 or dimension refused;
 # listTimes; -postProcess replaying a metric (validate's value) and a
-# function object; validate on a run that stopped early; compare and
+# function object; a plugin's metric (validate, -postProcess); validate on a run that stopped early; compare and
 # stability passing -endTime and -l0 to their runs; -version and the banner.
 # argv: mpsflow, tutorials/damBreak2D, tutorials/damBreak3D
 mpsflow=$1; tutorial=$2; tutorial3d=$3
@@ -154,6 +154,33 @@ check "-postProcess -funcs '(kineticEnergy)': one line a selected snapshot" \
 "$mpsflow" -postProcess -func surgeFrnt -case "$c" > "$c/log.bad" 2>&1
 check "-postProcess of an unknown name lists what there is" \
     "[ \$? -eq 1 ] && grep -q 'not a function of.*(energy).*surgeFront' '$c/log.bad'"
+
+# ---- a plugin's metric: finalKineticEnergy of libkineticEnergy.so ---------------------
+fresh energy; c=$dir/energy
+sed -i 's/^\( *interval \).*/\1 1;/' "$c/system/controlDict" # the energy function: every step
+printf 'metric finalKineticEnergy;\nlibs ("libkineticEnergy.so");\n' > "$c/validation/metric"
+"$mpsflow" -case "$c" -endTime 0.1 > "$c/log" 2>&1
+check "mpsflow modules -libs lists the plugin's metric" \
+    "'$mpsflow' modules -libs '(libkineticEnergy.so)' | grep -A30 '^metric modules:' |
+     grep -q '^ *finalKineticEnergy '"
+v=$("$mpsflow" validate -case "$c" | sed -n 's/^error finalKineticEnergy = //p')
+check "validate scores the run with the plugin's metric (libs in validation/metric): $v" \
+    "[ -n '$v' ] && [ \$(grep -vc '^#' '$c/validation/result.csv') -eq 12 ]"
+# The metric reads E from the snapshot at 0.05; the function object computed
+# it in the run, from the particles in memory, at the same step.
+p=$("$mpsflow" -postProcess -func finalKineticEnergy -time 0.05 -case "$c" |
+    sed -n 's/^error finalKineticEnergy = //p')
+e=$(awk '$1 > 0.0499999 && $1 < 0.0500001 {print $2}' "$c/postProcessing/energy/kineticEnergy.dat")
+check "... -time 0.05: the run's own kinetic energy at 0.05 ($p, in the run $e)" \
+    "[ -n '$p' ] && [ -n '$e' ] && awk 'BEGIN {d = $p / $e - 1; exit !(d < 1e-5 && d > -1e-5 && $p > 0)}'"
+sed -i '/^libs /d; /^functions/,$d' "$c/system/controlDict" # the library only in validation/metric
+q=$("$mpsflow" -postProcess -func finalKineticEnergy -time 0.05 -case "$c" |
+    sed -n 's/^error finalKineticEnergy = //p')
+check "... the same with the library named only in validation/metric ($q)" "[ -n '$q' ] && [ '$q' = '$p' ]"
+echo 'relativeTo -1;' >> "$c/validation/metric"
+"$mpsflow" validate -case "$c" > "$c/log.bad" 2>&1
+check "the host checks the plugin metric's keys: relativeTo -1 refused with file and line" \
+    "[ \$? -eq 1 ] && grep -q 'validation/metric:3:1: key .relativeTo.: -1 is out of range' '$c/log.bad'"
 
 # ---- compare and stability pass -endTime and -l0 ------------------------------------
 fresh cmp; c=$dir/cmp

@@ -188,6 +188,47 @@ typedef struct mf_surface_ops {
     int (*reconstruct)(void *data, const mf_sim *sim, struct mf_mesh *out);
 } mf_surface_ops;
 
+/* ---- metric: scores a run against reference data (validation) --------- */
+/* What a metric works on: the case (its validation/ reference data, its
+ * constant/), the snapshots to use (all of output/ for `validate`, the
+ * -time selection for `-postProcess`) and where its report goes
+ * (validation/ for `validate`, postProcessing/<name>/ for -postProcess). */
+typedef struct mf_metric_ctx {
+    const char *case_dir;
+    const int *selected;   /* snapshot indices, ascending; NULL: every snapshot */
+    size_t nselected;
+    const char *out_dir;   /* result.csv and result.png go here */
+    /* validation/metric itself, for entries a parameter table cannot hold
+     * (a list: volumeFlux's stations); its other keys are in the settings. */
+    const mf_dict *dict;
+    /* Set by the host, so that a metric (a plugin's too) reads snapshots
+     * without the io layer. snapshots: the indices of ctx's snapshots,
+     * ascending (malloc'ed: free *indices). read_snapshot: snapshot `index`
+     * into a zeroed *snap: snap->p (every particle the file holds; free it
+     * with mf_particles_destroy), snap->dim, l0, time, step, and the case's
+     * fluids (snap->fluid, nfluids: mf_sim_particle_mass works on it). */
+    int (*snapshots)(const struct mf_metric_ctx *ctx, int **indices, size_t *n);
+    int (*read_snapshot)(const struct mf_metric_ctx *ctx, int index, mf_sim *snap);
+} mf_metric_ctx;
+
+/* ABI 3 (the kind itself). info.params are the keys of the case's
+ * validation/metric (the `metric` key that names it among them): the host
+ * checks the file against them and fills the settings (mf_module_prepare)
+ * before it calls evaluate, so a typo is refused with its file, line and
+ * key. Metrics run after the run, in the post-processing layer
+ * (driver/post): they read snapshots and write reports; no solver calls
+ * them. */
+typedef struct mf_metric_ops {
+    mf_module_info info;
+    /* Required. Score the snapshots of ctx: write ctx->out_dir/result.csv
+     * (and, where it can, result.png), set *error (smaller is better; the
+     * number `mpsflow validate` prints). */
+    int (*evaluate)(const void *settings, const mf_metric_ctx *ctx, double *error);
+    /* Keys of validation/metric that evaluate reads from ctx->dict itself
+     * (NULL-terminated; may be NULL). FoamFile is always allowed. */
+    const char *const *extra_keys;
+} mf_metric_ops;
+
 /* The size of a kind's table as a module built for ABI version abi has it
  * (0: unknown kind or version). Tables only grow, so an older table is the
  * prefix of the current layout of this size. */

@@ -32,8 +32,9 @@
 /* Versions of the tables' layout (mf_modules.h lists what each added):
  *   1  the first tables;
  *   2  force: flags, stable_dt, write_fields, claim_surface_pressure,
- *      surface_pressure; pressure: solve_rows; writer: purge. */
-#define MF_ABI_VERSION 2
+ *      surface_pressure; pressure: solve_rows; writer: purge;
+ *   3  the metric kind (mf_metric_ops). */
+#define MF_ABI_VERSION 3
 #define MF_ABI_OLDEST 1
 
 typedef enum {
@@ -44,6 +45,7 @@ typedef enum {
     MF_KIND_FUNCTION_OBJECT,
     MF_KIND_SURFACE,
     MF_KIND_WRITER,
+    MF_KIND_METRIC, /* ABI 3 */
     MF_KIND_COUNT
 } mf_module_kind;
 

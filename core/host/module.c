@@ -51,6 +51,8 @@ size_t mf_ops_size(mf_module_kind kind, int abi)
     case MF_KIND_SURFACE: return sizeof(mf_surface_ops);
     /* ABI 2 added purge. */
     case MF_KIND_WRITER: return abi >= 2 ? sizeof(mf_writer_ops) : offsetof(mf_writer_ops, purge);
+    /* ABI 3 added the kind: an older module cannot be a metric. */
+    case MF_KIND_METRIC: return abi >= 3 ? sizeof(mf_metric_ops) : 0;
     default: return 0;
     }
 }

@@ -26,7 +26,7 @@ struct mf_registry {
 };
 
 static const char *const kind_names[MF_KIND_COUNT] = {
-    "solver", "pressure", "convection", "force", "functionObject", "surface", "writer",
+    "solver", "pressure", "convection", "force", "functionObject", "surface", "writer", "metric",
 };
 
 const char *mf_module_kind_name(mf_module_kind kind)
@@ -96,6 +96,11 @@ int mf_registry_add(mf_registry *reg, const mf_module_info *m)
                         m->name, m->abi_version, MF_ABI_OLDEST, MF_ABI_VERSION);
     if (m->kind < 0 || m->kind >= MF_KIND_COUNT)
         return MF_ERROR(MF_ERR_INPUT, "module '%s' has an unknown kind %d", m->name, (int)m->kind);
+    if (mf_ops_size(m->kind, m->abi_version) == 0) /* a kind newer than the module's version */
+        return MF_ERROR(MF_ERR_INPUT,
+                        "module '%s' is a %s module, a kind added after the module ABI version "
+                        "%d it was built for: rebuild it against this version's headers",
+                        m->name, kind_names[m->kind], m->abi_version);
     if (m->nparams && !m->params)
         return MF_ERROR(MF_ERR_INPUT, "module '%s' declares %zu parameters but no table",
                         m->name, m->nparams);

@@ -14,9 +14,10 @@
 const mf_param mf_watch_params[] = {
     {"enabled", MF_PARAM_BOOL, "yes", MF_NO_RANGE, NULL, offsetof(mf_watch_settings, enabled),
      "check every step for the signs of instability"},
-    {"energyTolerance", MF_PARAM_SCALAR, "0.25", 1e-6, 1e6, NULL,
+    {"energyTolerance", MF_PARAM_SCALAR, "0.02", 1e-6, 1e6, NULL,
      offsetof(mf_watch_settings, energy_tolerance),
-     "kinetic energy gained without a source, as a fraction of the run's energy scale"},
+     "kinetic energy gained without a source (beyond the work of the forces, moving walls "
+     "and surface energy), as a fraction of the run's energy scale"},
     {"densityCollapse", MF_PARAM_SCALAR, "0.5", 0, 1, NULL,
      offsetof(mf_watch_settings, density_collapse),
      "mean fluid number density below this fraction of n0 means the fluid blew apart"},
@@ -253,15 +254,20 @@ static int check_energy(mf_watch *w, const mf_sim *sim, double dt)
     if (!w->started) { /* the state the run starts from (after its first step) */
         w->started = true;
         w->ke0 = ke;
-        w->pot_scale = mass_acc * fluid_extent(sim) + surface_energy(sim);
+        w->pot_scale = mass_acc * fluid_extent(sim);
+        w->surface_scale = surface_energy(sim);
         w->next_work = 0;
+        w->next_excess = 0;
         return 0;
     }
     /* The work of the step's forces, a^n held over the step while u goes
      * from u^n to u^{n+1}: the trapezoidal rule in u. */
     w->next_work = w->work + 0.5 * (power_start + power_end) * dt;
-    double excess = ke - w->ke0 - w->next_work;
-    double scale = w->ke0 + fabs(w->next_work) + w->pot_scale + w->wall_scale;
+    const double unreported = w->wall_scale + w->surface_scale; /* A of mf_watch.h */
+    double excess = ke - w->ke0 - w->next_work - unreported;
+    double scale = w->ke0 + fabs(w->next_work) + w->pot_scale + unreported;
+    w->next_excess = scale > 0 ? excess / scale : 0;
+    w->next_time = sim->time;
     if (!(scale > 0 && excess > w->s.energy_tolerance * scale))
         return 0;
     double speed = 0;
@@ -271,10 +277,11 @@ static int check_energy(mf_watch *w, const mf_sim *sim, double dt)
     const double *x = f.x;
     return MF_ERROR(MF_ERR_NUMERIC,
                     "unstable (energy) at time %g, step %ld: the fluid's kinetic energy %g J "
-                    "exceeds its start %g J plus the work of the forces %g J by %g J, more "
+                    "exceeds its start %g J plus the work of the forces %g J (and %g J that "
+                    "moving walls and surface tension may give) by %g J, more "
                     "than energyTolerance %g of the energy scale %g J; fastest: fluid particle "
                     "id %lld at (%g %g %g), %g m/s",
-                    sim->time, sim->step, ke, w->ke0, w->next_work, excess,
+                    sim->time, sim->step, ke, w->ke0, w->next_work, unreported, excess,
                     w->s.energy_tolerance, scale, (long long)f.id, x[0], x[1], x[2], speed);
 }
 
@@ -299,4 +306,8 @@ int mf_watch_check(mf_watch *w, const mf_sim *sim, double dt)
 void mf_watch_accept(mf_watch *w)
 {
     w->work = w->next_work;
+    if (w->next_excess > w->peak_excess) {
+        w->peak_excess = w->next_excess;
+        w->peak_excess_time = w->next_time;
+    }
 }

@@ -100,7 +100,7 @@ static void write_report(const char *case_dir, compare_row *rows, size_t n)
     }
 }
 
-int mf_cmd_compare(const mf_options *o)
+int mf_cmd_compare(mf_registry *reg, const mf_options *o)
 {
     const char *case_dir = o->case_dir, *solvers = o->solvers, *resolutions = o->resolutions;
     char end_text[64], one_l0[80];
@@ -154,7 +154,7 @@ int mf_cmd_compare(const mf_options *o)
             mf_read_run_summary(run_dir, &row->summary);
             row->error = NAN;
             if (row->child.exit_status == 0) {
-                if (mf_cmd_validate(run_dir, &row->error) != 0) {
+                if (mf_cmd_validate(reg, run_dir, &row->error) != 0) {
                     fprintf(stderr, "  validate failed: %s\n", mf_error_message());
                     mf_error_clear();
                 }

@@ -26,7 +26,7 @@ static const mf_param_section watch_sections[] = {
 
 typedef void (*section_fn)(const mf_param_section *s, FILE *f);
 
-static void each_section(const char *name, section_fn fn, FILE *f)
+static void each_section(const mf_registry *reg, const char *name, section_fn fn, FILE *f)
 {
     if (!strcmp(name, "controlDict") || !strcmp(name, "watch")) {
         mf_param_section s = !strcmp(name, "watch") ? watch_sections[0] : control_sections[0];
@@ -48,12 +48,12 @@ static void each_section(const char *name, section_fn fn, FILE *f)
         for (size_t k = 0; k < mf_fluid_nsections; k++)
             fn(&mf_fluid_sections[k], f);
     } else if (!strcmp(name, "validation")) {
-        const size_t n = mf_nmetrics;
-        const mf_metric *const *m = mf_metrics;
-        for (size_t k = 0; k < n; k++) {
+        /* Every registered metric (plugins' too): validation/metric names one. */
+        for (size_t k = 0; k < mf_registry_count(reg, MF_KIND_METRIC); k++) {
+            const mf_module_info *m = mf_registry_at(reg, MF_KIND_METRIC, k);
             char title[160];
-            snprintf(title, sizeof title, "validation/metric: metric %s", m[k]->name);
-            mf_param_section s = {title, m[k]->summary, m[k]->params, m[k]->nparams};
+            snprintf(title, sizeof title, "validation/metric: metric %s", m->name);
+            mf_param_section s = {title, m->summary, m->params, m->nparams};
             fn(&s, f);
         }
     } else if (!strcmp(name, "compareDict")) {
@@ -82,11 +82,11 @@ static void print_markdown(const mf_param_section *s, FILE *f)
     fputc('\n', f);
 }
 
-bool mf_dict_tables_print(const char *name, FILE *f)
+bool mf_dict_tables_print(const mf_registry *reg, const char *name, FILE *f)
 {
     for (size_t k = 0; mf_dict_table_names[k]; k++)
         if (!strcmp(mf_dict_table_names[k], name)) {
-            each_section(name, print_text, f);
+            each_section(reg, name, print_text, f);
             return true;
         }
     return false;
@@ -105,12 +105,12 @@ int mf_cmd_reference(mf_registry *reg, const char *path)
                "## Case dictionaries\n\n");
     for (size_t k = 0; mf_dict_table_names[k]; k++) {
         fprintf(f, "## %s\n\n", mf_dict_table_names[k]);
-        each_section(mf_dict_table_names[k], print_markdown, f);
+        each_section(reg, mf_dict_table_names[k], print_markdown, f);
     }
     fprintf(f, "## Modules\n\n");
     for (int kind = 0; kind < MF_KIND_COUNT; kind++) {
         size_t n = mf_registry_count(reg, (mf_module_kind)kind);
-        if (n == 0)
+        if (n == 0 || kind == MF_KIND_METRIC) /* metrics: under "validation" above */
             continue;
         fprintf(f, "## %s modules\n\n", mf_module_kind_name((mf_module_kind)kind));
         for (size_t i = 0; i < n; i++) {

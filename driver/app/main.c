@@ -182,7 +182,7 @@ int mf_cmd_modules(mf_registry *reg, const char *name)
         printf("\n");
         return 0;
     }
-    if (mf_dict_tables_print(name, stdout))
+    if (mf_dict_tables_print(reg, name, stdout))
         return 0;
     const mf_module_info *m = mf_registry_lookup_any(reg, name);
     if (!m) {
@@ -255,6 +255,12 @@ static int run_case(mf_app *app)
         mf_log_printf(&app->log, MF_LOG_QUIET, "Force %s: %ld calls, %.3f s\n",
                       app->sim.forces[k].info->name, app->sim.forces[k].calls,
                       app->sim.forces[k].seconds);
+    const mf_watch *watch = &app->run.watch;
+    if (watch->s.enabled && watch->started && isfinite(watch->s.energy_tolerance))
+        mf_log_printf(&app->log, MF_LOG_QUIET,
+                      "Watch: kinetic energy above its start and the forces' work by at most "
+                      "%.3g of the energy scale (t = %g; energyTolerance %g)\n",
+                      watch->peak_excess, watch->peak_excess_time, watch->s.energy_tolerance);
     mf_log_printf(&app->log, MF_LOG_QUIET,
                   "\nSteps %ld (retried %ld), snapshots %d, wall time %.2f s, peak memory %.1f "
                   "MB\n",
@@ -413,9 +419,9 @@ int main(int argc, char **argv)
     else if (rc == 0 && !strcmp(command, "reference") && root)
         rc = mf_cmd_reference(app.reg, module_name);
     else if (rc == 0 && !strcmp(command, "validate") && root)
-        rc = mf_cmd_validate(app.opt.case_dir, &error);
+        rc = mf_cmd_validate(app.reg, app.opt.case_dir, &error);
     else if (rc == 0 && !strcmp(command, "compare"))
-        rc = mf_cmd_compare(&app.opt);
+        rc = mf_cmd_compare(app.reg, &app.opt);
     else if (rc == 0 && !strcmp(command, "stability"))
         rc = mf_cmd_stability(&app.opt);
     /* A failure every rank agreed on is printed once; one that a rank met

@@ -101,8 +101,9 @@ extern const mf_param_section mf_stability_sections[];
 extern const size_t mf_stability_nsections;
 extern const mf_param_section mf_decompose_sections[]; /* parallel_setup.c */
 extern const size_t mf_decompose_nsections;
-/* Print the tables of the case dictionary `name` (false: no such one). */
-bool mf_dict_tables_print(const char *name, FILE *f);
+/* Print the tables of the case dictionary `name` (false: no such one);
+ * validation's are those of the metrics registered in reg. */
+bool mf_dict_tables_print(const mf_registry *reg, const char *name, FILE *f);
 /* The names mf_dict_tables_print knows, NULL-terminated. */
 extern const char *const mf_dict_table_names[];
 /* docs/reference.md: every dictionary's and every module's keys. */
@@ -130,20 +131,23 @@ int mf_cmd_run(mf_app *app);
 int mf_cmd_modules(mf_registry *reg, const char *name);
 /* `mpsflow validate -case DIR`: prints "error <metric> = <value>"; fails
  * (after printing it, marked) when the run did not reach its endTime. */
-int mf_cmd_validate(const char *case_dir, double *error);
+int mf_cmd_validate(mf_registry *reg, const char *case_dir, double *error);
 /* The metric `name` (NULL: the one validation/metric names; its settings
  * come from there) over the selected snapshots (NULL: all), its report in
- * out_dir. *used: the metric (may be NULL). */
-struct mf_metric;
-int mf_metric_evaluate(const char *case_dir, const char *name, const int *selected,
-                       size_t nselected, const char *out_dir, double *error,
-                       const struct mf_metric **used);
+ * out_dir. The metric is found in reg (after loading the plugins the
+ * file's `libs` names). *used: the metric (may be NULL). */
+int mf_metric_evaluate(mf_registry *reg, const char *case_dir, const char *name,
+                       const int *selected, size_t nselected, const char *out_dir,
+                       double *error, const mf_metric_ops **used);
+/* Load the plugins that DIR/validation/metric names in its `libs` (none
+ * when there is no such file), so that its metric is registered. */
+int mf_app_load_metric_libs(mf_registry *reg, const char *case_dir);
 /* Why output/runSummary says the run did not reach endTime ("" if it did);
  * false when there is no runSummary. Clears the error trace. */
 bool mf_run_status_note(const char *case_dir, char *note, size_t len);
 
 /* `mpsflow compare`: see compare.c (-endTime is passed to each run). */
-int mf_cmd_compare(const mf_options *o);
+int mf_cmd_compare(mf_registry *reg, const mf_options *o);
 
 /* `mpsflow stability`: see stability.c (-l0 and -endTime passed to each run). */
 int mf_cmd_stability(const mf_options *o);

@@ -155,7 +155,7 @@ static int replay_metric(replay *r, const char *name)
     MF_CALL(mf_mkdir(out_dir));
     double error = 0;
     mf_run_status_note(app->cs.dir, note, sizeof note);
-    MF_CALL(mf_metric_evaluate(app->cs.dir, name, r->idx, r->n, out_dir, &error, NULL));
+    MF_CALL(mf_metric_evaluate(app->reg, app->cs.dir, name, r->idx, r->n, out_dir, &error, NULL));
     printf("error %s = %.6g%s%s%s\n", name, error, note[0] ? " (not a finished run's: " : "",
            note, note[0] ? ")" : "");
     mf_log_printf(&app->log, MF_LOG_QUIET, "-postProcess: %s over %zu snapshot(s) -> %s\n", name,
@@ -180,20 +180,20 @@ static int replay_one(replay *r, const char *name)
     char fo_names[2048];
     snprintf(fo_names, sizeof fo_names, "%s", mf_error_message());
     mf_error_clear();
-    if (mf_metric_find(name))
+    MF_CALL(mf_app_load_metric_libs(app->reg, app->cs.dir)); /* a plugin's metric */
+    if (mf_registry_find(app->reg, MF_KIND_METRIC, name, &found) == 0)
         return replay_metric(r, name);
+    char metric_names[2048];
+    snprintf(metric_names, sizeof metric_names, "%s", mf_error_message());
+    mf_error_clear();
     char functions[1024] = "";
     for (size_t k = 0; fns && k < fns->n; k++)
         snprintf(functions + strlen(functions), sizeof functions - strlen(functions), "%s%s",
                  k ? " " : "", fns->entries[k]->key);
-    char metrics[1024] = "";
-    for (size_t k = 0; k < mf_nmetrics; k++)
-        snprintf(metrics + strlen(metrics), sizeof metrics - strlen(metrics), "%s%s",
-                 k ? " " : "", mf_metrics[k]->name);
     return MF_ERROR(MF_ERR_INPUT,
                     "-func %s: not a function of %s/system/controlDict (%s), a function object "
-                    "type, nor a metric (%s). %s",
-                    name, app->cs.dir, functions[0] ? functions : "none", metrics, fo_names);
+                    "type, nor a metric. %s. %s",
+                    name, app->cs.dir, functions[0] ? functions : "none", metric_names, fo_names);
 }
 
 int mf_cmd_post_process(mf_app *app)

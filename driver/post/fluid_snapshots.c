@@ -10,8 +10,7 @@
 #include "mf_post.h"
 #include "mf_scene.h"
 
-/* The case's constant/fluids into sim's fluid table. */
-static int read_fluids(const char *case_dir, mf_sim *sim)
+int mf_post_read_fluids(const char *case_dir, mf_sim *sim)
 {
     char path[4200];
     snprintf(path, sizeof path, "%s/constant/fluids", case_dir);
@@ -26,7 +25,7 @@ static int read_fluids(const char *case_dir, mf_sim *sim)
 int mf_post_fluid_index(const char *case_dir, const char *name, int *index)
 {
     mf_sim sim;
-    int rc = read_fluids(case_dir, &sim);
+    int rc = mf_post_read_fluids(case_dir, &sim);
     if (rc == 0)
         rc = mf_scene_fluid_index(&sim, name, index);
     if (rc != 0)
@@ -37,7 +36,7 @@ int mf_post_fluid_index(const char *case_dir, const char *name, int *index)
 int mf_post_fluid_densities(const char *case_dir, double rho[MF_MAX_FLUIDS])
 {
     mf_sim sim;
-    MF_CALL(read_fluids(case_dir, &sim));
+    MF_CALL(mf_post_read_fluids(case_dir, &sim));
     for (int k = 0; k < sim.nfluids; k++)
         rho[k] = sim.fluid[k].rho;
     return 0;

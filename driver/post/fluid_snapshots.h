@@ -18,6 +18,8 @@
 /* Index of a fluid of the case by name (constant/fluids order); the error
  * names the case's validation/metric. */
 int mf_post_fluid_index(const char *case_dir, const char *name, int *index);
+/* *sim zeroed, then its fluid table from the case's constant/fluids. */
+int mf_post_read_fluids(const char *case_dir, mf_sim *sim);
 /* The densities of the case's fluids (constant/fluids order). */
 int mf_post_fluid_densities(const char *case_dir, double rho[MF_MAX_FLUIDS]);
 

@@ -37,7 +37,6 @@ static const mf_param containment_params[] = {
      offsetof(containment_settings, obst_max),
      "upper corner of a box obstacle, m (equal corners: none)"},
 };
-static const char *const containment_extra[] = {"FoamFile", NULL};
 #define NCP (sizeof containment_params / sizeof containment_params[0])
 
 static bool in_box(const double *x, const double *mn, const double *mx, double grow, int dim)
@@ -48,10 +47,9 @@ static bool in_box(const double *x, const double *mn, const double *mx, double g
     return true;
 }
 
-static int evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
+static int evaluate(const void *settings, const mf_metric_ctx *ctx, double *error)
 {
-    containment_settings s;
-    MF_CALL(mf_params_apply(containment_params, NCP, md, containment_extra, &s, NULL));
+    containment_settings s = *(const containment_settings *)settings;
     int *idx = NULL;
     size_t nsnap = 0;
     MF_CALL(mf_metric_snapshots(ctx, &idx, &nsnap));
@@ -113,7 +111,10 @@ static int evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
     return rc;
 }
 
-const mf_metric mf_metric_containment = {
-    "containment",
-    "fluid kept: particle count, none outside the tank or inside the obstacle (no reference)",
-    evaluate, containment_params, NCP};
+const mf_metric_ops mf_metric_containment = {
+    {MF_ABI_VERSION, MF_KIND_METRIC, "containment",
+     "fluid kept: particle count, none outside the tank or inside the obstacle (no reference)",
+     containment_params, NCP, sizeof(containment_settings)},
+    evaluate,
+    NULL,
+};

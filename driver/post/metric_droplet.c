@@ -48,7 +48,6 @@ static const mf_param laplace_params[] = {
     {"innerRadius", MF_PARAM_SCALAR, "0.5", 0.01, 1, NULL, offsetof(laplace_settings, inner),
      "p_in over r < innerRadius R (the drop's core, away from the interface band)"},
 };
-static const char *const metric_extra[] = {"FoamFile", NULL};
 
 /* Roundness: the drop's outer radius in 36 angular sectors (2-D: angle in
  * the x-y plane); std / mean. A square gives about 0.12, a circle ~0.02.
@@ -76,11 +75,10 @@ static double roundness(const mf_fsnap *s, int fluid, const double c[3], double 
     return m > 0 ? sqrt(v) / m : 0;
 }
 
-static int laplace_evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
+static int laplace_evaluate(const void *settings, const mf_metric_ctx *ctx, double *error)
 {
     const char *case_dir = ctx->case_dir;
-    laplace_settings s;
-    MF_CALL(mf_params_apply(laplace_params, 8, md, metric_extra, &s, NULL));
+    laplace_settings s = *(const laplace_settings *)settings;
     double R = s.radius > 0 ? s.radius : s.side / sqrt(M_PI);
     if (!(R > 0))
         return MF_ERROR(MF_ERR_INPUT, "%s/validation/metric: give radius or squareSide",
@@ -191,10 +189,13 @@ static int laplace_evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double 
     return rc;
 }
 
-const mf_metric mf_metric_laplace = {"laplacePressure",
-                                     "pressure jump of a droplet at rest against Laplace",
-                                     laplace_evaluate,
-    laplace_params, sizeof laplace_params / sizeof laplace_params[0]};
+const mf_metric_ops mf_metric_laplace = {
+    {MF_ABI_VERSION, MF_KIND_METRIC, "laplacePressure",
+     "pressure jump of a droplet at rest against Laplace",
+     laplace_params, sizeof laplace_params / sizeof laplace_params[0], sizeof(laplace_settings)},
+    laplace_evaluate,
+    NULL,
+};
 
 /* ---- oscillationPeriod ------------------------------------------------------ */
 
@@ -218,11 +219,10 @@ static const mf_param osc_params[] = {
      "ignore the snapshots before this time, s"},
 };
 
-static int osc_evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
+static int osc_evaluate(const void *settings, const mf_metric_ctx *ctx, double *error)
 {
     const char *case_dir = ctx->case_dir;
-    osc_settings s;
-    MF_CALL(mf_params_apply(osc_params, 6, md, metric_extra, &s, NULL));
+    osc_settings s = *(const osc_settings *)settings;
     int drop = -1;
     if (s.drop[0])
         MF_CALL(mf_post_fluid_index(case_dir, s.drop, &drop));
@@ -308,7 +308,10 @@ static int osc_evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *err
     return rc;
 }
 
-const mf_metric mf_metric_oscillation = {"oscillationPeriod",
-                                         "mode-2 oscillation period of a drop against Rayleigh",
-                                         osc_evaluate,
-    osc_params, sizeof osc_params / sizeof osc_params[0]};
+const mf_metric_ops mf_metric_oscillation = {
+    {MF_ABI_VERSION, MF_KIND_METRIC, "oscillationPeriod",
+     "mode-2 oscillation period of a drop against Rayleigh",
+     osc_params, sizeof osc_params / sizeof osc_params[0], sizeof(osc_settings)},
+    osc_evaluate,
+    NULL,
+};

@@ -21,7 +21,6 @@ typedef struct front_settings {
     double a, back_wall, g, end_wall;
 } front_settings;
 
-static const char *const metric_extra[] = {"FoamFile", NULL};
 
 static const mf_param front_params[] = {
     {"metric", MF_PARAM_WORD, NULL, MF_NO_RANGE, NULL, offsetof(front_settings, metric),
@@ -56,11 +55,10 @@ static int fluid_front(const mf_fsnap *sn, int fluid, double back_wall, double *
     return rc;
 }
 
-static int front_evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
+static int front_evaluate(const void *settings, const mf_metric_ctx *ctx, double *error)
 {
     const char *case_dir = ctx->case_dir;
-    front_settings s;
-    MF_CALL(mf_params_apply(front_params, 7, md, metric_extra, &s, NULL));
+    front_settings s = *(const front_settings *)settings;
     int fluid = 0;
     MF_CALL(mf_post_fluid_index(case_dir, s.fluid, &fluid));
     char path[4400];
@@ -132,6 +130,10 @@ static int front_evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *e
     return rc;
 }
 
-const mf_metric mf_metric_fluid_surge_front = {
-    "fluidSurgeFront", "dam-break surge front of one fluid among several", front_evaluate,
-    front_params, sizeof front_params / sizeof front_params[0]};
+const mf_metric_ops mf_metric_fluid_surge_front = {
+    {MF_ABI_VERSION, MF_KIND_METRIC, "fluidSurgeFront",
+     "dam-break surge front of one fluid among several",
+     front_params, sizeof front_params / sizeof front_params[0], sizeof(front_settings)},
+    front_evaluate,
+    NULL,
+};

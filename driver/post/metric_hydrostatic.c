@@ -33,13 +33,11 @@ static const mf_param hydro_params[] = {
     {"settleTime", MF_PARAM_SCALAR, "0", 0, 1e9, NULL, offsetof(hydro_settings, settle),
      "average only snapshots after this time, s"},
 };
-static const char *const hydro_extra[] = {"FoamFile", NULL};
 
-static int evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
+static int evaluate(const void *settings, const mf_metric_ctx *ctx, double *error)
 {
     const char *case_dir = ctx->case_dir;
-    hydro_settings s;
-    MF_CALL(mf_params_apply(hydro_params, 6, md, hydro_extra, &s, NULL));
+    hydro_settings s = *(const hydro_settings *)settings;
     const double H = s.surface - s.bottom;
     int *idx = NULL;
     size_t nsnap = 0;
@@ -132,6 +130,10 @@ static int evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
     return rc;
 }
 
-const mf_metric mf_metric_hydrostatic = {"hydrostaticPressure",
-                                         "time-averaged pressure of a resting column", evaluate,
-    hydro_params, sizeof hydro_params / sizeof hydro_params[0]};
+const mf_metric_ops mf_metric_hydrostatic = {
+    {MF_ABI_VERSION, MF_KIND_METRIC, "hydrostaticPressure",
+     "time-averaged pressure of a resting column",
+     hydro_params, sizeof hydro_params / sizeof hydro_params[0], sizeof(hydro_settings)},
+    evaluate,
+    NULL,
+};

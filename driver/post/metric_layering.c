@@ -16,7 +16,6 @@ typedef struct layer_settings {
     double bottom, cross, settle;
 } layer_settings;
 
-static const char *const metric_extra[] = {"FoamFile", NULL};
 
 static const mf_param layer_params[] = {
     {"metric", MF_PARAM_WORD, NULL, MF_NO_RANGE, NULL, offsetof(layer_settings, metric),
@@ -33,11 +32,10 @@ static const mf_param layer_params[] = {
      "average over the snapshots after this time, s"},
 };
 
-static int layer_evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
+static int layer_evaluate(const void *settings, const mf_metric_ctx *ctx, double *error)
 {
     const char *case_dir = ctx->case_dir;
-    layer_settings s;
-    MF_CALL(mf_params_apply(layer_params, 6, md, metric_extra, &s, NULL));
+    layer_settings s = *(const layer_settings *)settings;
     int heavy = 0, light = 0;
     MF_CALL(mf_post_fluid_index(case_dir, s.heavy, &heavy));
     MF_CALL(mf_post_fluid_index(case_dir, s.light, &light));
@@ -116,7 +114,10 @@ static int layer_evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *e
     return rc;
 }
 
-const mf_metric mf_metric_layering = {"layering",
-                                      "two fluids settled: light above the interface height",
-                                      layer_evaluate,
-    layer_params, sizeof layer_params / sizeof layer_params[0]};
+const mf_metric_ops mf_metric_layering = {
+    {MF_ABI_VERSION, MF_KIND_METRIC, "layering",
+     "two fluids settled: light above the interface height",
+     layer_params, sizeof layer_params / sizeof layer_params[0], sizeof(layer_settings)},
+    layer_evaluate,
+    NULL,
+};

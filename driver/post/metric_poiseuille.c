@@ -47,7 +47,6 @@ static const mf_param poiseuille_params[] = {
     {"bottom", MF_PARAM_SCALAR, "0", -1e9, 1e9, NULL, offsetof(poiseuille_settings, bottom),
      "y of the lower plate, m"},
 };
-static const char *const poiseuille_extra[] = {"FoamFile", NULL};
 
 static const mf_param couette_params[] = {
     {"metric", MF_PARAM_WORD, NULL, MF_NO_RANGE, NULL, offsetof(poiseuille_settings, metric),
@@ -98,8 +97,6 @@ static double couette_u(const poiseuille_settings *s, double y, double t)
 typedef struct channel_flow {
     const char *name;             /* for the report */
     const char *reference;        /* the analytic solution's source */
-    const mf_param *params;
-    size_t nparams;
     double (*u)(const poiseuille_settings *s, double y, double t);
     double (*scale)(const poiseuille_settings *s, double t); /* the error's denominator */
 } channel_flow;
@@ -115,11 +112,9 @@ static double couette_scale(const poiseuille_settings *s, double t)
 }
 
 static const channel_flow poiseuille_flow = {
-    "Poiseuille", "Morris et al. (1997) eq. 21", poiseuille_params,
-    sizeof poiseuille_params / sizeof poiseuille_params[0], poiseuille_u, poiseuille_scale};
+    "Poiseuille", "Morris et al. (1997) eq. 21", poiseuille_u, poiseuille_scale};
 static const channel_flow couette_flow = {
-    "Couette", "Morris et al. (1997) eq. 22", couette_params,
-    sizeof couette_params / sizeof couette_params[0], couette_u, couette_scale};
+    "Couette", "Morris et al. (1997) eq. 22", couette_u, couette_scale};
 
 typedef struct sample {
     double y, u, exact;
@@ -179,13 +174,11 @@ static int write_report(const char *out_dir, const channel_flow *flow,
     return rc;
 }
 
-static int evaluate_flow(const channel_flow *flow, const mf_metric_ctx *ctx, const mf_dict *md,
-                         double *error)
+static int evaluate_flow(const channel_flow *flow, const void *settings,
+                         const mf_metric_ctx *ctx, double *error)
 {
     const char *case_dir = ctx->case_dir;
-    poiseuille_settings s;
-    memset(&s, 0, sizeof s);
-    MF_CALL(mf_params_apply(flow->params, flow->nparams, md, poiseuille_extra, &s, NULL));
+    poiseuille_settings s = *(const poiseuille_settings *)settings;
     int *idx = NULL;
     size_t nsnap = 0;
     MF_CALL(mf_metric_snapshots(ctx, &idx, &nsnap));
@@ -235,24 +228,29 @@ static int evaluate_flow(const channel_flow *flow, const mf_metric_ctx *ctx, con
     return rc;
 }
 
-static int evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
+static int evaluate(const void *settings, const mf_metric_ctx *ctx, double *error)
 {
-    return evaluate_flow(&poiseuille_flow, ctx, md, error);
+    return evaluate_flow(&poiseuille_flow, settings, ctx, error);
 }
 
-static int evaluate_couette(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
+static int evaluate_couette(const void *settings, const mf_metric_ctx *ctx, double *error)
 {
-    return evaluate_flow(&couette_flow, ctx, md, error);
+    return evaluate_flow(&couette_flow, settings, ctx, error);
 }
 
-const mf_metric mf_metric_couette = {
-    "couette",
-    "start-up of plane Couette flow (a sliding lid) against Morris et al. (1997) eq. 22 "
+const mf_metric_ops mf_metric_couette = {
+    {MF_ABI_VERSION, MF_KIND_METRIC, "couette",
+     "start-up of plane Couette flow (a sliding lid) against Morris et al. (1997) eq. 22 "
     "(RMS of u over the lid speed)",
-    evaluate_couette, couette_params, sizeof couette_params / sizeof couette_params[0]};
+     couette_params, sizeof couette_params / sizeof couette_params[0], sizeof(poiseuille_settings)},
+    evaluate_couette,
+    NULL,
+};
 
-const mf_metric mf_metric_poiseuille = {
-    "poiseuille",
-    "start-up of plane Poiseuille flow against Morris et al. (1997) eq. 21 (relative RMS of u)",
+const mf_metric_ops mf_metric_poiseuille = {
+    {MF_ABI_VERSION, MF_KIND_METRIC, "poiseuille",
+     "start-up of plane Poiseuille flow against Morris et al. (1997) eq. 21 (relative RMS of u)",
+     poiseuille_params, sizeof poiseuille_params / sizeof poiseuille_params[0], sizeof(poiseuille_settings)},
     evaluate,
-    poiseuille_params, sizeof poiseuille_params / sizeof poiseuille_params[0]};
+    NULL,
+};

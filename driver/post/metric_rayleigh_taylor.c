@@ -18,7 +18,6 @@ typedef struct rt_settings {
     double bottom, height, gravity;
 } rt_settings;
 
-static const char *const metric_extra[] = {"FoamFile", NULL};
 
 static const mf_param rt_params[] = {
     {"metric", MF_PARAM_WORD, NULL, MF_NO_RANGE, NULL, offsetof(rt_settings, metric),
@@ -35,11 +34,10 @@ static const mf_param rt_params[] = {
      "g, m/s^2"},
 };
 
-static int rt_evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
+static int rt_evaluate(const void *settings, const mf_metric_ctx *ctx, double *error)
 {
     const char *case_dir = ctx->case_dir;
-    rt_settings s;
-    MF_CALL(mf_params_apply(rt_params, 6, md, metric_extra, &s, NULL));
+    rt_settings s = *(const rt_settings *)settings;
     int heavy = 0, light = 0;
     MF_CALL(mf_post_fluid_index(case_dir, s.heavy, &heavy));
     MF_CALL(mf_post_fluid_index(case_dir, s.light, &light));
@@ -117,6 +115,10 @@ static int rt_evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *erro
     return rc;
 }
 
-const mf_metric mf_metric_rayleigh_taylor = {
-    "rayleighTaylor", "spike and bubble of a Rayleigh-Taylor instability", rt_evaluate,
-    rt_params, sizeof rt_params / sizeof rt_params[0]};
+const mf_metric_ops mf_metric_rayleigh_taylor = {
+    {MF_ABI_VERSION, MF_KIND_METRIC, "rayleighTaylor",
+     "spike and bubble of a Rayleigh-Taylor instability",
+     rt_params, sizeof rt_params / sizeof rt_params[0], sizeof(rt_settings)},
+    rt_evaluate,
+    NULL,
+};

@@ -51,7 +51,6 @@ static const mf_param tank_params[] = {
      "upper corner of the tank's wall faces, m (an open top: above the fluid)"},
 };
 #define TANK_NPARAMS (sizeof tank_params / sizeof tank_params[0])
-static const char *const tank_extra[] = {"FoamFile", NULL};
 
 typedef struct tank_snapshot {
     double time, speed, pressure;
@@ -100,10 +99,9 @@ static int read_one(const char *path, const tank_settings *s, tank_snapshot *out
     return rc;
 }
 
-static int evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
+static int evaluate(const void *settings, const mf_metric_ctx *ctx, double *error)
 {
-    tank_settings s;
-    MF_CALL(mf_params_apply(tank_params, TANK_NPARAMS, md, tank_extra, &s, NULL));
+    tank_settings s = *(const tank_settings *)settings;
     const double H = s.surface - s.bottom;
     if (!(H > 0))
         return MF_ERROR(MF_ERR_INPUT, "%s/validation/metric: surface %g is not above bottom %g",
@@ -186,6 +184,10 @@ static int evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
     return rc;
 }
 
-const mf_metric mf_metric_resting_tank = {
-    "restingTank", "a tank at rest: largest speed, bottom pressure, particles past the walls",
-    evaluate, tank_params, TANK_NPARAMS};
+const mf_metric_ops mf_metric_resting_tank = {
+    {MF_ABI_VERSION, MF_KIND_METRIC, "restingTank",
+     "a tank at rest: largest speed, bottom pressure, particles past the walls",
+     tank_params, TANK_NPARAMS, sizeof(tank_settings)},
+    evaluate,
+    NULL,
+};

@@ -36,7 +36,6 @@ static const mf_param scalar_params[] = {
     {"block", MF_PARAM_WORD, "", MF_NO_RANGE, NULL, offsetof(scalar_settings, block),
      "fluid block whose profile is f0 (empty: the first that declares the field)"},
 };
-static const char *const scalar_extra[] = {"FoamFile", NULL};
 
 /* f0: the field's entry in a fluid block of constant/geometry. */
 static int initial_profile(const char *case_dir, const scalar_settings *s, int dim,
@@ -123,12 +122,10 @@ static int write_report(const char *out_dir, const scalar_settings *s, const poi
     return rc;
 }
 
-static int evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
+static int evaluate(const void *settings, const mf_metric_ctx *ctx, double *error)
 {
     const char *case_dir = ctx->case_dir;
-    scalar_settings s;
-    MF_CALL(mf_params_apply(scalar_params, sizeof scalar_params / sizeof scalar_params[0], md,
-                            scalar_extra, &s, NULL));
+    scalar_settings s = *(const scalar_settings *)settings;
     int *idx = NULL;
     size_t nsnap = 0;
     MF_CALL(mf_metric_snapshots(ctx, &idx, &nsnap));
@@ -180,10 +177,13 @@ static int evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
     return rc;
 }
 
-const mf_metric mf_metric_scalar_advection = {
-    "scalarAdvection", "a transported scalar against its initial profile shifted by U t",
+const mf_metric_ops mf_metric_scalar_advection = {
+    {MF_ABI_VERSION, MF_KIND_METRIC, "scalarAdvection",
+     "a transported scalar against its initial profile shifted by U t",
+     scalar_params, sizeof scalar_params / sizeof scalar_params[0], sizeof(scalar_settings)},
     evaluate,
-    scalar_params, sizeof scalar_params / sizeof scalar_params[0]};
+    NULL,
+};
 
 /* ---- volumeFlux: the flow rate through cross-sections of a channel ------
  * Continuity says every cross-section of a channel carries the inflow,
@@ -213,7 +213,7 @@ static const mf_param flux_params[] = {
     {"height", MF_PARAM_SCALAR, "1", 1e-12, 1e12, NULL, offsetof(flux_settings, height),
      "step height S, m: the reattachment length is also given in S"},
 };
-static const char *const flux_extra[] = {"FoamFile", "stations", NULL};
+static const char *const flux_extra[] = {"stations", NULL};
 
 static int read_stations(const mf_dict *md, double **x, size_t *n)
 {
@@ -268,15 +268,13 @@ static double unsteadiness(const mf_particles *a, const mf_particles *b, double 
     return count ? sqrt(sum / (double)count) / speed : NAN;
 }
 
-static int flux_evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
+static int flux_evaluate(const void *settings, const mf_metric_ctx *ctx, double *error)
 {
     const char *case_dir = ctx->case_dir;
-    flux_settings s;
-    MF_CALL(mf_params_apply(flux_params, sizeof flux_params / sizeof flux_params[0], md,
-                            flux_extra, &s, NULL));
+    flux_settings s = *(const flux_settings *)settings;
     double *xs = NULL;
     size_t ns = 0;
-    MF_CALL(read_stations(md, &xs, &ns));
+    MF_CALL(read_stations(ctx->dict, &xs, &ns));
     int *idx = NULL;
     size_t nsnap = 0;
     int rc = mf_metric_snapshots(ctx, &idx, &nsnap);
@@ -372,7 +370,10 @@ static int flux_evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *er
     return rc;
 }
 
-const mf_metric mf_metric_volume_flux = {
-    "volumeFlux", "flow rate through cross-sections of a channel against the inflow",
+const mf_metric_ops mf_metric_volume_flux = {
+    {MF_ABI_VERSION, MF_KIND_METRIC, "volumeFlux",
+     "flow rate through cross-sections of a channel against the inflow",
+     flux_params, sizeof flux_params / sizeof flux_params[0], sizeof(flux_settings)},
     flux_evaluate,
-    flux_params, sizeof flux_params / sizeof flux_params[0]};
+    flux_extra,
+};

@@ -37,7 +37,6 @@ static const mf_param sloshing_params[] = {
     {"startTime", MF_PARAM_SCALAR, "0", 0, 1e9, NULL, offsetof(sloshing_settings, start),
      "ignore the snapshots before this time (the excitation), s"},
 };
-static const char *const sloshing_extra[] = {"FoamFile", NULL};
 #define NSP (sizeof sloshing_params / sizeof sloshing_params[0])
 
 /* q of one snapshot: the fluid's centroid x less the tank's. */
@@ -67,10 +66,9 @@ static int offset_of(const char *path, double *t, double *q)
     return 0;
 }
 
-static int evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
+static int evaluate(const void *settings, const mf_metric_ctx *ctx, double *error)
 {
-    sloshing_settings s;
-    MF_CALL(mf_params_apply(sloshing_params, NSP, md, sloshing_extra, &s, NULL));
+    sloshing_settings s = *(const sloshing_settings *)settings;
     int *idx = NULL;
     size_t nsnap = 0;
     MF_CALL(mf_metric_snapshots(ctx, &idx, &nsnap));
@@ -131,7 +129,10 @@ static int evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
     return rc;
 }
 
-const mf_metric mf_metric_sloshing = {
-    "sloshingPeriod",
-    "period of free sloshing in a rectangular tank against the linear mode-1 period",
-    evaluate, sloshing_params, NSP};
+const mf_metric_ops mf_metric_sloshing = {
+    {MF_ABI_VERSION, MF_KIND_METRIC, "sloshingPeriod",
+     "period of free sloshing in a rectangular tank against the linear mode-1 period",
+     sloshing_params, NSP, sizeof(sloshing_settings)},
+    evaluate,
+    NULL,
+};

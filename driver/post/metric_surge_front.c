@@ -33,7 +33,6 @@ static const mf_param front_params[] = {
     {"gravity", MF_PARAM_SCALAR, "9.81", 1e-9, 1e9, NULL, offsetof(front_settings, g),
      "g, m/s^2"},
 };
-static const char *const front_extra[] = {"FoamFile", NULL};
 
 /* Counts i's neighbours, stopping at two. */
 static inline bool count_two(void *acc, const void *ctx, const mf_pair *pr)
@@ -82,11 +81,10 @@ static int front_of(const mf_sim *snap, double back_wall, double *z)
     return rc;
 }
 
-static int evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
+static int evaluate(const void *settings, const mf_metric_ctx *ctx, double *error)
 {
     const char *case_dir = ctx->case_dir;
-    front_settings s;
-    MF_CALL(mf_params_apply(front_params, 5, md, front_extra, &s, NULL));
+    front_settings s = *(const front_settings *)settings;
     char path[4400];
     snprintf(path, sizeof path, "%s/validation/%s", case_dir, s.reference);
     double *Tref = NULL, *Zref = NULL;
@@ -165,7 +163,10 @@ static int evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *error)
     return rc;
 }
 
-const mf_metric mf_metric_surge_front = {"surgeFront",
-                                         "dam-break surge front Z(T) against an experiment",
-                                         evaluate,
-    front_params, sizeof front_params / sizeof front_params[0]};
+const mf_metric_ops mf_metric_surge_front = {
+    {MF_ABI_VERSION, MF_KIND_METRIC, "surgeFront",
+     "dam-break surge front Z(T) against an experiment",
+     front_params, sizeof front_params / sizeof front_params[0], sizeof(front_settings)},
+    evaluate,
+    NULL,
+};

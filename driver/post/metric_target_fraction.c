@@ -37,7 +37,6 @@ static const mf_param fraction_params[] = {
      "beside"},
 };
 #define FRACTION_NPARAMS (sizeof fraction_params / sizeof fraction_params[0])
-static const char *const fraction_extra[] = {"FoamFile", NULL};
 
 /* The fractions of every snapshot of case_dir (all of them: the selection
  * applies to the case validated, and the uncontrolled run's times are matched
@@ -101,10 +100,9 @@ static void series_free(fraction_series *s)
     free(s->f);
 }
 
-static int evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *value)
+static int evaluate(const void *settings, const mf_metric_ctx *ctx, double *value)
 {
-    fraction_settings s;
-    MF_CALL(mf_params_apply(fraction_params, FRACTION_NPARAMS, md, fraction_extra, &s, NULL));
+    fraction_settings s = *(const fraction_settings *)settings;
     int *idx = NULL;
     size_t nsnap = 0;
     MF_CALL(mf_metric_snapshots(ctx, &idx, &nsnap));
@@ -172,6 +170,10 @@ static int evaluate(const mf_metric_ctx *ctx, const mf_dict *md, double *value)
     return rc;
 }
 
-const mf_metric mf_metric_target_fraction = {
-    "targetFraction", "fraction of the fluid inside a target shape (control forces)", evaluate,
-    fraction_params, FRACTION_NPARAMS};
+const mf_metric_ops mf_metric_target_fraction = {
+    {MF_ABI_VERSION, MF_KIND_METRIC, "targetFraction",
+     "fraction of the fluid inside a target shape (control forces)",
+     fraction_params, FRACTION_NPARAMS, sizeof(fraction_settings)},
+    evaluate,
+    NULL,
+};

@@ -1,24 +1,16 @@
-/* metrics.c: the table of validation metrics (validation/metric names one)
- * and the snapshots a metric works on. */
+/* metrics.c: the registration of the post-processing modules (every
+ * validation metric, the surface function object) and the snapshots a
+ * metric works on. */
 #include <stdlib.h>
 #include <string.h>
 
+#include "fluid_snapshots.h"
 #include "mf_error.h"
+#include "mf_hdf5.h"
 #include "mf_post.h"
 
-extern const mf_metric mf_metric_scalar_advection; /* metric_scalar.c */
-extern const mf_metric mf_metric_volume_flux;      /* metric_scalar.c */
-extern const mf_metric mf_metric_poiseuille;       /* metric_poiseuille.c */
-extern const mf_metric mf_metric_couette;          /* metric_poiseuille.c */
-extern const mf_metric mf_metric_sloshing;         /* metric_sloshing.c */
-extern const mf_metric mf_metric_containment;      /* metric_containment.c */
-extern const mf_metric mf_metric_resting_tank;     /* metric_resting_tank.c */
-extern const mf_metric mf_metric_target_fraction;  /* metric_target_fraction.c */
-/* metric_droplet.c: the multi-fluid cases */
-extern const mf_metric mf_metric_laplace, mf_metric_oscillation, mf_metric_layering,
-    mf_metric_rayleigh_taylor, mf_metric_fluid_surge_front;
-
-const mf_metric *const mf_metrics[] = {
+/* Every metric of this layer, in the order `mpsflow modules` lists them. */
+static const mf_metric_ops *const metrics[] = {
     &mf_metric_surge_front,
     &mf_metric_hydrostatic,
     &mf_metric_scalar_advection,
@@ -35,14 +27,13 @@ const mf_metric *const mf_metrics[] = {
     &mf_metric_resting_tank,
     &mf_metric_target_fraction,
 };
-const size_t mf_nmetrics = sizeof mf_metrics / sizeof mf_metrics[0];
 
-const mf_metric *mf_metric_find(const char *name)
+int mf_post_register_all(mf_registry *reg)
 {
-    for (size_t k = 0; k < mf_nmetrics; k++)
-        if (strcmp(mf_metrics[k]->name, name) == 0)
-            return mf_metrics[k];
-    return NULL;
+    MF_CALL(mf_registry_add(reg, &mf_function_surface.info));
+    for (size_t k = 0; k < sizeof metrics / sizeof metrics[0]; k++)
+        MF_CALL(mf_registry_add(reg, &metrics[k]->info));
+    return 0;
 }
 
 int mf_metric_snapshots(const mf_metric_ctx *ctx, int **indices, size_t *n)
@@ -56,5 +47,19 @@ int mf_metric_snapshots(const mf_metric_ctx *ctx, int **indices, size_t *n)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory");
     memcpy(*indices, ctx->selected, ctx->nselected * sizeof **indices);
     *n = ctx->nselected;
+    return 0;
+}
+
+int mf_metric_read_snapshot(const mf_metric_ctx *ctx, int index, mf_sim *snap)
+{
+    char path[4400];
+    mf_snapshot_path(ctx->case_dir, index, path, sizeof path);
+    mf_hdf5_header h;
+    MF_CALL(mf_hdf5_read_header(path, &h));
+    MF_CALL(mf_post_read_fluids(ctx->case_dir, snap)); /* masses: mf_sim_particle_mass */
+    MF_CALL(mf_hdf5_read_snapshot(path, snap));
+    snap->time = h.time;
+    snap->step = h.step;
+    snap->l0 = h.l0;
     return 0;
 }

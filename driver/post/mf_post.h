@@ -16,32 +16,20 @@
 int mf_list_snapshots(const char *case_dir, int **indices, size_t *n);
 void mf_snapshot_path(const char *case_dir, int index, char *path, size_t len);
 
-/* What a metric works on: the case (its validation/ reference data, its
- * constant/), the snapshots to use (all of output/ for `validate`, the
- * -time selection for `-postProcess`) and where its report goes
- * (validation/ for `validate`, postProcessing/<name>/ for -postProcess). */
-typedef struct mf_metric_ctx {
-    const char *case_dir;
-    const int *selected;   /* snapshot indices, ascending; NULL: every snapshot */
-    size_t nselected;
-    const char *out_dir;   /* result.csv and result.png go here */
-} mf_metric_ctx;
-/* The snapshots of ctx (a malloc'ed copy: free *indices). */
+/* The snapshots of a metric's context (mf_metric_ctx, mf_modules.h): a
+ * malloc'ed copy, free *indices. */
 int mf_metric_snapshots(const mf_metric_ctx *ctx, int **indices, size_t *n);
+/* One snapshot of the case into a zeroed *snap (p, dim, l0, time, step):
+ * what the host puts in mf_metric_ctx.read_snapshot. */
+int mf_metric_read_snapshot(const mf_metric_ctx *ctx, int index, mf_sim *snap);
 
-/* A validation metric: reads the snapshots, writes result.csv and
- * result.png, returns the error. */
-typedef struct mf_metric {
-    const char *name;
-    const char *summary;
-    int (*evaluate)(const mf_metric_ctx *ctx, const mf_dict *metric_dict, double *error);
-    const mf_param *params; /* the keys of validation/metric besides `metric` */
-    size_t nparams;
-} mf_metric;
-/* Every metric, and the one named (NULL if none). */
-extern const mf_metric *const mf_metrics[];
-extern const size_t mf_nmetrics;
-const mf_metric *mf_metric_find(const char *name);
+/* The validation metrics (kind metric, mf_metric_ops): validation/metric
+ * names one; mf_post_register_all registers every one. */
+extern const mf_metric_ops mf_metric_surge_front, mf_metric_hydrostatic,
+    mf_metric_scalar_advection, mf_metric_volume_flux, mf_metric_laplace,
+    mf_metric_oscillation, mf_metric_layering, mf_metric_rayleigh_taylor,
+    mf_metric_fluid_surge_front, mf_metric_poiseuille, mf_metric_couette, mf_metric_sloshing,
+    mf_metric_containment, mf_metric_resting_tank, mf_metric_target_fraction;
 
 /* Snapshots with their times (from the headers), ascending. Free both. */
 int mf_snapshot_times(const char *case_dir, int **indices, double **times, size_t *n);
@@ -50,13 +38,10 @@ int mf_snapshot_times(const char *case_dir, int **indices, double **times, size_
  * "0.1:0.5", ":0.5", "0.5:". */
 int mf_select_times(const char *spec, const double *t, size_t n, bool *sel);
 
-extern const mf_metric mf_metric_surge_front;
-
 /* The surge front of a fluid particle set: the largest x - back_wall of a
  * particle with at least two neighbours within 2.1 l0 (lone splashes do not
  * count); 0 for no particle. */
 int mf_front_of_particles(const mf_particles *fluid, double l0, double back_wall, double *z);
-extern const mf_metric mf_metric_hydrostatic;
 
 /* Linear interpolation of y(x) at xq on ascending x; NAN outside. */
 double mf_interp(const double *x, const double *y, size_t n, double xq);
@@ -67,7 +52,8 @@ double mf_crossing_period(const double *t, const double *q, size_t n, double *cr
 /* Read a two-column CSV with '#' comments and one header line. */
 int mf_read_csv2(const char *path, double **a, double **b, size_t *n);
 
-/* Register the post-processing modules (the `surface` function object). */
+/* Register the post-processing modules: the `surface` function object and
+ * every metric. */
 int mf_post_register_all(mf_registry *reg);
 extern const mf_function_object_ops mf_function_surface;
 

@@ -133,9 +133,3 @@ const mf_function_object_ops mf_function_surface = {
     .destroy = fo_destroy,
     .write = fo_write,
 };
-
-int mf_post_register_all(mf_registry *reg)
-{
-    MF_CALL(mf_registry_add(reg, &mf_function_surface.info));
-    return 0;
-}
