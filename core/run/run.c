@@ -9,6 +9,7 @@
 #include <time.h>
 
 #include "mf_alloc.h"
+#include "mf_bodies.h"
 #include "mf_emitter.h"
 #include "mf_error.h"
 #include "mf_timestep.h"
@@ -315,6 +316,7 @@ static int step_once(mf_run *run, saved_state *saved, double next_write)
             MF_CALL(restore_state(saved, sim->p));
             sim->time = saved->time;
             mf_walls_set_time(sim->walls, sim->time); /* the walls where the particles are */
+            mf_bodies_set_committed(sim->walls);
             return mf_error_trace(rc, __FILE__, __LINE__, __func__);
         }
         mf_log_printf(sim->log, MF_LOG_QUIET,
@@ -337,6 +339,8 @@ static int step_once(mf_run *run, saved_state *saved, double next_write)
     }
     mf_watch_accept(&run->watch);
     sim->time = isnan(land) ? sim->time + dt : land;
+    /* The rigid bodies take the step's state and impulse (mf_bodies.h). */
+    MF_CALL(mf_bodies_accept(sim->walls, sim->time, dt));
     sim->step++;
     run->steps++;
     int rc = 0;

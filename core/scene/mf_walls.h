@@ -53,6 +53,7 @@ typedef enum {
     MF_MOTION_OSCILLATING, /* d = amplitude sin(omega t), angle = angleAmplitude sin(omega t) */
     MF_MOTION_TABLE,       /* d(t), angle(t) from tables of (time value) rows */
     MF_MOTION_EXTERNAL,    /* the state is set from outside (mf_wall_set_state) */
+    MF_MOTION_RIGID,       /* moved by the fluid's forces (rigid_bodies.c, mf_bodies.h) */
 } mf_motion_kind;
 
 /* A table of (t, value) rows, OpenFOAM's `table` habit: values of ncomp
@@ -75,6 +76,10 @@ typedef struct mf_motion {
     double angle_amplitude;       /* oscillating: rad */
     double cycles;                /* oscillating: stop after this many (0: never) */
     mf_motion_table disp, angle;  /* table (angle in rad) */
+    /* rigid: density or mass and principal inertia (body axes), gravity;
+     * origin is the centre of mass (origin_given: the case gave it). */
+    double density, mass, inertia[3], g[3];
+    bool origin_given;
 } mf_motion;
 
 /* The rigid state at one time: x = origin + d + R (x_b - origin). */
@@ -85,6 +90,7 @@ typedef struct mf_rigid_state {
 } mf_rigid_state;
 
 struct mf_wall_mesh; /* walls_mesh.c: triangles, pseudonormals, a cell index */
+struct mf_body;      /* rigid_bodies.c: a body moved by the fluid (mf_bodies.h) */
 
 typedef struct mf_wall {
     char name[64];
@@ -102,8 +108,11 @@ typedef struct mf_wall {
     mf_rigid_state state;    /* at state_time */
     double state_time;
     long first, count;       /* its particles in build order (particle walls), or 0 */
-    /* what the fluid did to it over the last step (wall weight walls): N, N m */
+    /* what the fluid did to it over the last step (wall weight walls; a
+     * rigid body's, summed by the solver over its particles): N, N m about
+     * origin + d (2-D: per metre of depth) */
     double force[3], torque[3];
+    struct mf_body *body;    /* motion rigid: its dynamics, else NULL */
 } mf_wall;
 
 typedef struct mf_walls {
@@ -136,6 +145,8 @@ void mf_motion_state(const mf_motion *m, double t, mf_rigid_state *s);
 /* Every solid's state at time t (external laws keep theirs). */
 void mf_walls_set_time(mf_walls *ws, double t);
 void mf_wall_set_state(mf_wall *w, const mf_rigid_state *s, double t);
+/* The rotation by angle (rad) about the unit axis a (Rodrigues), row-major. */
+void mf_rotation_matrix(const double a[3], double angle, double R[9]);
 void mf_wall_to_body(const mf_wall *w, const double x[3], double xb[3]);
 void mf_wall_to_world(const mf_wall *w, const double xb[3], double x[3]);
 /* The solid's velocity at world point x (rigid motion; with_surface adds the

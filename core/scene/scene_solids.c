@@ -22,6 +22,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_bodies.h"
 #include "mf_error.h"
 #include "scene_internal.h"
 #include "walls_internal.h"
@@ -52,6 +53,13 @@ int mf_scene_solid_add(mf_sim *sim, mf_wall *w, size_t first)
     mf_walls *ws = sim->walls;
     w->first = (long)first;
     w->count = (long)(p->n - first);
+    if (w->motion.kind == MF_MOTION_RIGID) {
+        if (sim->wall_weight)
+            return MF_ERROR(MF_ERR_INPUT, "%s: '%s': rigid bodies need particle walls (the "
+                            "fluid's forces on them are summed over their particles)",
+                            w->where, w->name);
+        MF_CALL(mf_body_create(w, sim->dim));
+    }
     const bool moving = mf_wall_moves(w);
     size_t index;
     MF_CALL(mf_walls_add(ws, w, &index));

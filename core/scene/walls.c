@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_bodies.h"
 #include "mf_error.h"
 #include "walls_internal.h"
 
@@ -30,6 +31,7 @@ void mf_walls_destroy(mf_walls *ws)
     for (size_t k = 0; k < ws->n; k++) {
         mf_motion_free(&ws->w[k].motion);
         mf_wall_mesh_destroy(ws->w[k].mesh);
+        mf_body_destroy(ws->w[k].body);
     }
     free(ws->w);
     free(ws);
@@ -45,6 +47,7 @@ int mf_walls_add(mf_walls *ws, mf_wall *w, size_t *index)
     ws->w[ws->n].dim = ws->dim;
     memset(&w->motion, 0, sizeof w->motion); /* taken over with the mesh */
     w->mesh = NULL;
+    w->body = NULL;
     if (index)
         *index = ws->n;
     ws->n++;
@@ -279,9 +282,11 @@ int mf_walls_advance(mf_walls *ws, mf_particles *p, double t_from, double t_to)
     if (!from)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory moving the walls");
     mf_walls_set_time(ws, t_from);
+    mf_bodies_set_committed(ws);
     for (size_t k = 0; k < ws->n; k++)
         from[k] = ws->w[k].state;
     mf_walls_set_time(ws, t_to);
+    mf_bodies_set_trial(ws, t_to - t_from);
     mf_walls_move_particles(ws, from, p);
     free(from);
     return 0;

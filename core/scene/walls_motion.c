@@ -19,28 +19,32 @@
 #include "mf_walls.h"
 
 static const char *const motion_types[] = {"none",  "constant", "rotation", "oscillating",
-                                           "table", "external", NULL};
+                                           "table", "external", "rigid", NULL};
 static const char *const interpolations[] = {"linear", "spline", NULL};
 
 typedef struct motion_settings {
     const char *type, *interpolation;
     double origin[3], axis[3], velocity[3], amplitude[3];
     double omega, angle_amplitude, cycles;
+    double density, mass, inertia[3], g[3]; /* rigid */
 } motion_settings;
 
 const mf_param mf_motion_params[] = {
     {"type", MF_PARAM_WORD, "none", MF_NO_RANGE, motion_types, offsetof(motion_settings, type),
      "none, constant (velocity), rotation (omega about axis through origin), oscillating "
      "(amplitude sin(omega t), angleAmplitude sin(omega t)), table (displacement and angle "
-     "tables: ((t (dx dy dz)) ...), ((t degrees) ...)), external (set by a module)"},
+     "tables: ((t (dx dy dz)) ...), ((t degrees) ...)), external (set by a module), rigid (moved "
+     "by the fluid's pressure and viscous forces and gravity: rigid_bodies.c)"},
     {"origin", MF_PARAM_VECTOR, "(0 0 0)", MF_NO_RANGE, NULL, offsetof(motion_settings, origin),
-     "centre of rotation at t = 0, m"},
+     "centre of rotation at t = 0, m (rigid: the centre of mass; box, cylinder, sphere: their "
+     "centre unless given)"},
     {"axis", MF_PARAM_VECTOR, "(0 0 1)", MF_NO_RANGE, NULL, offsetof(motion_settings, axis),
      "axis of rotation (2-D: z, the only one)"},
     {"velocity", MF_PARAM_VECTOR, "(0 0 0)", MF_NO_RANGE, NULL,
-     offsetof(motion_settings, velocity), "constant: the velocity, m/s"},
+     offsetof(motion_settings, velocity), "constant: the velocity, m/s; rigid: the initial velocity"},
     {"omega", MF_PARAM_SCALAR, "0", -1e6, 1e6, NULL, offsetof(motion_settings, omega),
-     "rotation: angular velocity, rad/s; oscillating: angular frequency, rad/s"},
+     "rotation: angular velocity, rad/s; oscillating: angular frequency, rad/s; rigid: initial "
+     "angular velocity about axis, rad/s"},
     {"amplitude", MF_PARAM_VECTOR, "(0 0 0)", MF_NO_RANGE, NULL,
      offsetof(motion_settings, amplitude), "oscillating: displacement amplitude, m"},
     {"angleAmplitude", MF_PARAM_SCALAR, "0", -360, 360, NULL,
@@ -50,6 +54,16 @@ const mf_param mf_motion_params[] = {
     {"interpolation", MF_PARAM_WORD, "linear", MF_NO_RANGE, interpolations,
      offsetof(motion_settings, interpolation),
      "table: linear, or spline (natural cubic: the velocity is continuous)"},
+    {"density", MF_PARAM_SCALAR, "0", 0, 1e9, NULL, offsetof(motion_settings, density),
+     "rigid: density of the body, kg/m^3 (mass and inertia from the shape; 2-D: per metre of "
+     "depth); 0: give mass and inertia"},
+    {"mass", MF_PARAM_SCALAR, "0", 0, 1e12, NULL, offsetof(motion_settings, mass),
+     "rigid: mass, kg (2-D: kg/m), instead of density"},
+    {"inertia", MF_PARAM_VECTOR, "(0 0 0)", 0, 1e12, NULL, offsetof(motion_settings, inertia),
+     "rigid, with mass: principal moments of inertia about the centre of mass along the body "
+     "axes x, y, z, kg m^2 (2-D: only z, kg m)"},
+    {"g", MF_PARAM_VECTOR, "(0 -9.81 0)", -1e6, 1e6, NULL, offsetof(motion_settings, g),
+     "rigid: acceleration of gravity on the body, m/s^2 (the gravity force's g)"},
 };
 const size_t mf_motion_nparams = sizeof mf_motion_params / sizeof mf_motion_params[0];
 const mf_param_section mf_motion_sections[] = {
@@ -233,6 +247,13 @@ int mf_motion_read(const mf_dict *d, int dim, mf_motion *m)
     m->omega = s.omega;
     m->angle_amplitude = s.angle_amplitude * M_PI / 180;
     m->cycles = s.cycles;
+    m->density = s.density;
+    m->mass = s.mass;
+    m->origin_given = mf_dict_find(d, "origin") != NULL;
+    for (int a = 0; a < 3; a++) {
+        m->inertia[a] = s.inertia[a];
+        m->g[a] = dim == 2 && a == 2 ? 0 : s.g[a];
+    }
     const bool spline = strcmp(s.interpolation, "spline") == 0;
     int rc = read_table(d, "displacement", 3, 1.0, spline, &m->disp);
     if (rc == 0)
@@ -247,6 +268,18 @@ int mf_motion_read(const mf_dict *d, int dim, mf_motion *m)
     if (rc == 0 && m->kind == MF_MOTION_OSCILLATING && !(fabs(m->omega) > 0))
         rc = MF_ERROR(MF_ERR_INPUT, "%s: motion type oscillating needs omega (rad/s) != 0",
                       mf_loc_str(d->loc, where, sizeof where));
+    if (rc == 0 && m->kind == MF_MOTION_RIGID && !(m->density > 0) && !(m->mass > 0))
+        rc = MF_ERROR(MF_ERR_INPUT, "%s: motion type rigid needs a density (kg/m^3), or a mass "
+                      "and an inertia", mf_loc_str(d->loc, where, sizeof where));
+    if (rc == 0 && m->kind == MF_MOTION_RIGID && m->density > 0 && m->mass > 0)
+        rc = MF_ERROR(MF_ERR_INPUT, "%s: motion type rigid takes a density or a mass, not both",
+                      mf_loc_str(d->loc, where, sizeof where));
+    if (rc == 0 && m->kind == MF_MOTION_RIGID && m->mass > 0 &&
+        !(dim == 2 ? m->inertia[2] > 0
+                   : m->inertia[0] > 0 && m->inertia[1] > 0 && m->inertia[2] > 0))
+        rc = MF_ERROR(MF_ERR_INPUT, "%s: motion type rigid with a mass needs its inertia, e.g. "
+                      "inertia %s;", mf_loc_str(d->loc, where, sizeof where),
+                      dim == 2 ? "(0 0 0.01)" : "(0.01 0.01 0.01)");
     if (dim == 2)
         for (size_t k = 0; rc == 0 && k < m->disp.n; k++)
             m->disp.y[3 * k + 2] = 0;
@@ -259,8 +292,7 @@ int mf_motion_read(const mf_dict *d, int dim, mf_motion *m)
 
 /* ---- states -------------------------------------------------------------------- */
 
-/* Rotation by angle about unit axis a (Rodrigues), row-major. */
-static void rotation(const double a[3], double angle, double R[9])
+void mf_rotation_matrix(const double a[3], double angle, double R[9])
 {
     const double c = cos(angle), s = sin(angle), C = 1 - c;
     const double x = a[0], y = a[1], z = a[2];
@@ -279,7 +311,7 @@ static void identity_state(mf_rigid_state *s)
 /* An angle theta(t) about the axis with its rates into the state. */
 static void set_angle(const mf_motion *m, double th, double dth, double ddth, mf_rigid_state *s)
 {
-    rotation(m->axis, th, s->R);
+    mf_rotation_matrix(m->axis, th, s->R);
     for (int a = 0; a < 3; a++) {
         s->w[a] = dth * m->axis[a];
         s->dw[a] = ddth * m->axis[a];
@@ -341,7 +373,8 @@ void mf_walls_set_time(mf_walls *ws, double t)
 {
     for (size_t k = 0; ws && k < ws->n; k++) {
         mf_wall *w = &ws->w[k];
-        if (w->motion.kind == MF_MOTION_NONE || w->motion.kind == MF_MOTION_EXTERNAL)
+        if (w->motion.kind == MF_MOTION_NONE || w->motion.kind == MF_MOTION_EXTERNAL ||
+            w->motion.kind == MF_MOTION_RIGID)
             continue;
         mf_motion_state(&w->motion, t, &w->state);
         w->state_time = t;

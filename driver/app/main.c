@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "mf_app.h"
+#include "mf_bodies.h"
 #include "mf_error.h"
 #include "mf_post.h"
 #include "mf_walls.h"
@@ -220,6 +221,19 @@ static int run_case(mf_app *app)
                                   ? mf_app_remove_stale_tmp(app->cs.dir, &app->log, &stale)
                                   : 0));
     bool restart = mf_app_is_restart(app);
+    if (mf_bodies_count(app->sim.walls) > 0) {
+        /* Rigid bodies (mf_bodies.h): one rank, a fresh start at time 0. */
+        if (app->sim.par)
+            return MF_ERROR(MF_ERR_INPUT, "rigid bodies (motion type rigid) run on one rank only "
+                            "for now: run without -parallel");
+        if (restart || app->sim.time != 0)
+            return MF_ERROR(MF_ERR_INPUT, "rigid bodies (motion type rigid) start at time 0: "
+                            "their state is not in the snapshots yet (no -latestTime, "
+                            "startTime 0)");
+        char post[4400];
+        snprintf(post, sizeof post, "%s/postProcessing", app->cs.dir);
+        MF_CALL(mf_bodies_open_output(app->sim.walls, post, app->sim.time));
+    }
     if (restart) {
         const mf_writer_ops *w = (const mf_writer_ops *)app->writer.info;
         if (!w->read_latest)

@@ -26,6 +26,7 @@ static const mf_metric_ops *const metrics[] = {
     &mf_metric_containment,
     &mf_metric_resting_tank,
     &mf_metric_target_fraction,
+    &mf_metric_floating,
 };
 
 int mf_post_register_all(mf_registry *reg)

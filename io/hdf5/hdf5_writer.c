@@ -23,6 +23,7 @@
 #include <unistd.h>
 
 #include "hdf5_internal.h"
+#include "mf_bodies.h"
 #include "mf_error.h"
 #include "mf_hdf5.h"
 #include "mf_parallel_mpi.h"
@@ -302,6 +303,52 @@ static void close_all(hid_t *file)
     mf_h5_close(file);
 }
 
+/* /RigidBodies/<name>: the state of each body moved by the fluid
+ * (mf_bodies.h), as attributes: Mass, Centre, Rotation (body to world,
+ * row-major), Velocity, AngularVelocity, AngularMomentum, and the impulses
+ * of the last step not yet taken (Impulse, AngularImpulse). */
+static int write_bodies(const snap_writer *w, const mf_sim *sim)
+{
+    const mf_walls *ws = sim->walls;
+    if (mf_bodies_count(ws) == 0)
+        return 0;
+    char what[MF_H5_PATH_MAX], detail[256];
+    snprintf(what, sizeof what, "%s:/RigidBodies", w->path);
+    hid_t g = H5Gcreate2(w->file, "RigidBodies", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    if (g < 0)
+        return MF_ERROR(MF_ERR_IO, "%s: cannot create the group (%s)", what,
+                        mf_h5_error_detail(detail, sizeof detail));
+    int rc = 0;
+    for (size_t k = 0; rc == 0 && k < ws->n; k++) {
+        if (!ws->w[k].body)
+            continue;
+        mf_body_momentum b;
+        mf_body_get(&ws->w[k], &b);
+        snprintf(what, sizeof what, "%s:/RigidBodies/%s", w->path, ws->w[k].name);
+        hid_t gb = H5Gcreate2(g, ws->w[k].name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+        if (gb < 0) {
+            rc = MF_ERROR(MF_ERR_IO, "%s: cannot create the group (%s)", what,
+                          mf_h5_error_detail(detail, sizeof detail));
+            break;
+        }
+        const struct {
+            const char *name;
+            const double *v;
+            size_t n;
+        } a[] = {{"Mass", &b.mass, 0},           {"Centre", b.centre, 3},
+                 {"Rotation", b.rotation, 9},    {"Velocity", b.velocity, 3},
+                 {"AngularVelocity", b.omega, 3}, {"AngularMomentum", b.angular, 3},
+                 {"Impulse", b.impulse, 3},      {"AngularImpulse", b.angular_impulse, 3}};
+        for (size_t i = 0; rc == 0 && i < sizeof a / sizeof a[0]; i++)
+            rc = mf_h5_attr_write(gb, a[i].name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, a[i].n,
+                                  a[i].v, what);
+        H5Gclose(gb);
+    }
+    H5Gclose(g);
+    MF_CALL(rc);
+    return 0;
+}
+
 /* The header, the parameters and every kind's datasets into w->file. */
 static int write_contents(snap_writer *w, const mf_sim *sim, const mf_dict *params,
                           const int64_t counts[MF_NKINDS])
@@ -309,6 +356,7 @@ static int write_contents(snap_writer *w, const mf_sim *sim, const mf_dict *para
     MF_CALL(write_header(w, sim, counts));
     if (params)
         MF_CALL(write_parameters(w, params));
+    MF_CALL(write_bodies(w, sim));
     for (int kind = 0; kind < MF_NKINDS; kind++)
         if (counts[kind] > 0) {
             w->rows = (hsize_t)counts[kind];

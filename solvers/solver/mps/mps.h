@@ -305,6 +305,16 @@ int mps_source_start(mps_data *d, mf_sim *sim);
  * unknowns (in_ppe), or nothing for the density source of eq. 14. */
 int mps_source_terms(mps_data *d, const mf_sim *sim, double dt);
 
+/* mps_bodies.c: the force and torque of the fluid on the rigid bodies
+ * (core/scene/mf_bodies.h), the opposite of what the fluid received from
+ * their particles: begin (at the start of an attempt), the viscous share
+ * (explicit phase, lists at r^n), the pressure share (correction phase,
+ * lists at r*). Nothing without a rigid body; a clear error where the
+ * step's sums do not split over pairs or on several ranks. */
+void mps_bodies_begin(mps_data *d, mf_sim *sim);
+int mps_bodies_viscous(mps_data *d, mf_sim *sim);
+int mps_bodies_pressure(mps_data *d, mf_sim *sim, const double *pressure);
+
 /* mps_shift.c: particle shifting after the correction (Lind et al. 2012). */
 int mps_shift(mps_data *d, mf_sim *sim);
 

@@ -146,6 +146,7 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
         MF_CALL(mps_scheme_reserve(d, p->n));
     else
         MF_CALL(mps_source_start(d, sim)); /* what the scheme's source needs of r^n, u^n */
+    mps_bodies_begin(d, sim);
     memset(d->acc, 0, 3 * p->n * sizeof *d->acc);
     MF_CALL(mf_force_accumulate(sim, d->acc));
     if (d->visc) { /* viscosity implicit: u* = (I - dt nu lap)^-1 (u + dt a), r* = r + dt u* */
@@ -164,6 +165,7 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
         else
             mf_laplacian_add(&v, &d->k_lap, p->vel, nu, d->is_fluid, NULL, d->acc);
     }
+    MF_CALL(mps_bodies_viscous(d, sim)); /* the rigid bodies' share, at r^n */
     for (size_t i = 0; i < p->n_owned && !d->visc; i++) {
         if (!d->is_fluid[i])
             continue;
@@ -281,6 +283,7 @@ int mps_correction_phase(mps_data *d, mf_sim *sim, double dt)
     if (d->rho || d->sc.gradient != MPS_GRADIENT_PAPER) {
         /* a density per particle (1/rho_ij in the sum) or the scheme's gradient */
         MF_CALL(mps_gradient_pairs(d, sim, pr, NULL));
+        MF_CALL(mps_bodies_pressure(d, sim, pr)); /* the rigid bodies' share, at r* */
         mps_apply_correction(d, p, dt, NULL);
         if (!d->rho && d->s.collision && d->s.collision_after_correction)
             MF_CALL(collide(d, sim, dt));
@@ -291,6 +294,7 @@ int mps_correction_phase(mps_data *d, mf_sim *sim, double dt)
     mf_pairs v;
     MF_CALL(mps_pairs(d, sim, d->h_grad, &v));
     mf_gradient(&v, &d->k_grad, pr, d->s.gradient_pmin, d->is_fluid, d->not_dummy, d->grad);
+    MF_CALL(mps_bodies_pressure(d, sim, pr)); /* the rigid bodies' share, at r* */
     const double rho = sim->fluid[0].rho;
     for (size_t i = 0; i < p->n_owned; i++) {
         if (!d->is_fluid[i])

@@ -1,0 +1,512 @@
+/* rigid_bodies.c: the dynamics of the rigid bodies moved by the fluid
+ * (mf_bodies.h; Akinci et al. 2012, section 4: the fluid's pair forces on
+ * the body's particles summed into a force and a torque, integrated by
+ * symplectic Euler). */
+#include "mf_bodies.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mf_error.h"
+#include "mf_fs.h"
+
+typedef struct mf_body {
+    double mass;
+    double Ib[9], Ib_inv[9];  /* inertia about the centre of mass, body axes */
+    /* committed state at t^n */
+    double x[3], v[3], R[9], L[3], w[3];
+    /* the impulses of the step that ended at t^n: J = F dt, H = T dt */
+    double J[3], H[3];
+    /* the step being tried (mf_bodies_set_trial) */
+    double xt[3], vt[3], Rt[9], Lt[3], wt[3];
+    /* the surface its wall particles stand for (mf_body_surface_prepare):
+     * per box face (xmin xmax ymin ymax zmin zmax), or of a round shape, the
+     * area of the surface per wall particle within l0 of it */
+    bool surface_ready;
+    double face_area[6], round_area;
+    FILE *csv;
+} mf_body;
+
+static void mat_vec(const double M[9], const double x[3], double y[3])
+{
+    for (int a = 0; a < 3; a++)
+        y[a] = M[3 * a] * x[0] + M[3 * a + 1] * x[1] + M[3 * a + 2] * x[2];
+}
+
+static void mat_t_vec(const double M[9], const double x[3], double y[3])
+{
+    for (int a = 0; a < 3; a++)
+        y[a] = M[a] * x[0] + M[3 + a] * x[1] + M[6 + a] * x[2];
+}
+
+static void mat_mul(const double A[9], const double B[9], double C[9])
+{
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++)
+            C[3 * r + c] = A[3 * r] * B[c] + A[3 * r + 1] * B[3 + c] + A[3 * r + 2] * B[6 + c];
+}
+
+static void cross(const double a[3], const double b[3], double c[3])
+{
+    c[0] = a[1] * b[2] - a[2] * b[1];
+    c[1] = a[2] * b[0] - a[0] * b[2];
+    c[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* Inverse of a symmetric positive definite 3x3 matrix (the adjugate). */
+static bool invert3(const double A[9], double B[9])
+{
+    const double c00 = A[4] * A[8] - A[5] * A[7], c01 = A[5] * A[6] - A[3] * A[8],
+                 c02 = A[3] * A[7] - A[4] * A[6];
+    const double det = A[0] * c00 + A[1] * c01 + A[2] * c02;
+    if (!(det > 0))
+        return false;
+    B[0] = c00 / det;
+    B[1] = (A[2] * A[7] - A[1] * A[8]) / det;
+    B[2] = (A[1] * A[5] - A[2] * A[4]) / det;
+    B[3] = c01 / det;
+    B[4] = (A[0] * A[8] - A[2] * A[6]) / det;
+    B[5] = (A[2] * A[3] - A[0] * A[5]) / det;
+    B[6] = c02 / det;
+    B[7] = (A[1] * A[6] - A[0] * A[7]) / det;
+    B[8] = (A[0] * A[4] - A[1] * A[3]) / det;
+    return true;
+}
+
+/* Volume (2-D: area), the centre and the inertia per unit mass of a shape. */
+static int shape_inertia(const mf_wall *w, int dim, double *volume, double centre[3],
+                         double I[9])
+{
+    memset(I, 0, 9 * sizeof *I);
+    if (w->shape == MF_SOLID_BOX) {
+        double e[3] = {1, 1, 1};
+        *volume = 1;
+        for (int a = 0; a < 3; a++) {
+            centre[a] = a < dim ? 0.5 * (w->min[a] + w->max[a]) : 0;
+            if (a < dim) {
+                e[a] = w->max[a] - w->min[a];
+                *volume *= e[a];
+            }
+        }
+        if (dim == 2)
+            e[2] = 0;
+        I[0] = (e[1] * e[1] + e[2] * e[2]) / 12;
+        I[4] = (e[0] * e[0] + e[2] * e[2]) / 12;
+        I[8] = (e[0] * e[0] + e[1] * e[1]) / 12;
+        return 0;
+    }
+    const double r = w->radius;
+    memcpy(centre, w->centre, 3 * sizeof *centre);
+    if (dim == 2 && (w->shape == MF_SOLID_CYLINDER || w->shape == MF_SOLID_SPHERE)) {
+        *volume = M_PI * r * r; /* a disk */
+        I[0] = I[4] = 0.25 * r * r;
+        I[8] = 0.5 * r * r;
+        return 0;
+    }
+    if (w->shape == MF_SOLID_SPHERE) {
+        *volume = 4.0 / 3.0 * M_PI * r * r * r;
+        I[0] = I[4] = I[8] = 0.4 * r * r;
+        return 0;
+    }
+    if (w->shape == MF_SOLID_CYLINDER) {
+        const double L = 2 * w->half_length;
+        if (!(L > 0))
+            return MF_ERROR(MF_ERR_INPUT, "%s: obstacle '%s': a rigid cylinder in 3-D needs a "
+                            "length (an endless one has no mass)", w->where, w->name);
+        *volume = M_PI * r * r * L;
+        /* (3 r^2 + L^2)/12 across the axis a, r^2/2 along it */
+        const double across = (3 * r * r + L * L) / 12, along = 0.5 * r * r;
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++)
+                I[3 * i + j] = across * ((i == j) - w->axis[i] * w->axis[j]) +
+                               along * w->axis[i] * w->axis[j];
+        return 0;
+    }
+    return MF_ERROR(MF_ERR_INPUT, "%s: obstacle '%s': a rigid mesh body needs its mass, inertia "
+                    "and origin (the centre of mass) in motion { type rigid; mass ...; inertia "
+                    "(...); origin (...); } (density works for box, cylinder and sphere)",
+                    w->where, w->name);
+}
+
+int mf_body_create(mf_wall *w, int dim)
+{
+    mf_motion *m = &w->motion;
+    if (!w->obstacle)
+        return MF_ERROR(MF_ERR_INPUT, "%s: wall '%s': motion type rigid is for obstacles (a "
+                        "body in the fluid), not for the walls that hold it", w->where, w->name);
+    mf_body *b = calloc(1, sizeof *b);
+    if (!b)
+        return MF_ERROR(MF_ERR_MEMORY, "out of memory");
+    double volume = 0, centre[3] = {0, 0, 0}, I[9];
+    int rc = 0;
+    if (m->density > 0 || !m->origin_given) {
+        rc = shape_inertia(w, dim, &volume, centre, I);
+        if (rc != 0) {
+            free(b);
+            return mf_error_trace(rc, __FILE__, __LINE__, __func__);
+        }
+    }
+    if (m->density > 0) {
+        b->mass = m->density * volume;
+        for (int k = 0; k < 9; k++)
+            b->Ib[k] = b->mass * I[k];
+    } else {
+        b->mass = m->mass;
+        b->Ib[0] = m->inertia[0];
+        b->Ib[4] = m->inertia[1];
+        b->Ib[8] = m->inertia[2];
+    }
+    if (dim == 2) { /* only Izz acts: the others only keep the matrix invertible */
+        b->Ib[1] = b->Ib[2] = b->Ib[3] = b->Ib[5] = b->Ib[6] = b->Ib[7] = 0;
+        b->Ib[0] = b->Ib[4] = b->Ib[8];
+    }
+    if (!invert3(b->Ib, b->Ib_inv)) {
+        free(b);
+        return MF_ERROR(MF_ERR_INPUT, "%s: obstacle '%s': its inertia is not positive definite",
+                        w->where, w->name);
+    }
+    if (!m->origin_given)
+        memcpy(m->origin, centre, sizeof centre);
+    memcpy(b->x, m->origin, sizeof b->x);
+    memcpy(b->v, m->velocity, sizeof b->v);
+    b->R[0] = b->R[4] = b->R[8] = 1;
+    for (int a = 0; a < 3; a++)
+        b->w[a] = m->omega * m->axis[a];
+    mat_vec(b->Ib, b->w, b->L); /* R = I at t = 0 */
+    memcpy(b->xt, b->x, sizeof b->x);
+    memcpy(b->vt, b->v, sizeof b->v);
+    memcpy(b->Rt, b->R, sizeof b->R);
+    memcpy(b->Lt, b->L, sizeof b->L);
+    memcpy(b->wt, b->w, sizeof b->w);
+    w->body = b;
+    memset(&w->state, 0, sizeof w->state);
+    memcpy(w->state.R, b->R, sizeof b->R);
+    memcpy(w->state.v, b->v, sizeof b->v);
+    memcpy(w->state.w, b->w, sizeof b->w);
+    return 0;
+}
+
+void mf_body_destroy(mf_body *b)
+{
+    if (!b)
+        return;
+    if (b->csv)
+        fclose(b->csv);
+    free(b);
+}
+
+size_t mf_bodies_count(const mf_walls *ws)
+{
+    size_t n = 0;
+    for (size_t k = 0; ws && k < ws->n; k++)
+        n += ws->w[k].body != NULL;
+    return n;
+}
+
+/* The wall's rigid state from a body state (x the centre, R, v, w; a and dw
+ * the change over the step). */
+static void to_state(mf_wall *w, const double x[3], const double R[9], const double v[3],
+                     const double om[3], const double a[3], const double dw[3])
+{
+    mf_rigid_state *s = &w->state;
+    for (int c = 0; c < 3; c++) {
+        s->d[c] = x[c] - w->motion.origin[c];
+        s->v[c] = v[c];
+        s->a[c] = a[c];
+        s->w[c] = om[c];
+        s->dw[c] = dw[c];
+    }
+    memcpy(s->R, R, sizeof s->R);
+}
+
+void mf_bodies_set_committed(mf_walls *ws)
+{
+    static const double zero[3] = {0, 0, 0};
+    for (size_t k = 0; ws && k < ws->n; k++) {
+        mf_wall *w = &ws->w[k];
+        mf_body *b = w->body;
+        if (b)
+            to_state(w, b->x, b->R, b->v, b->w, zero, zero);
+    }
+}
+
+void mf_bodies_set_trial(mf_walls *ws, double dt)
+{
+    for (size_t k = 0; ws && k < ws->n; k++) {
+        mf_wall *w = &ws->w[k];
+        mf_body *b = w->body;
+        if (!b)
+            continue;
+        const int dim = ws->dim;
+        double a[3], dw[3], Linv[3], wb[3];
+        for (int c = 0; c < 3; c++) {
+            b->vt[c] = c < dim ? b->v[c] + b->J[c] / b->mass + dt * w->motion.g[c] : 0;
+            b->Lt[c] = b->L[c] + b->H[c];
+            b->xt[c] = b->x[c] + dt * b->vt[c];
+        }
+        if (dim == 2)
+            b->Lt[0] = b->Lt[1] = 0;
+        /* w = R I_b^-1 R^T L with the orientation at t^n */
+        mat_t_vec(b->R, b->Lt, Linv);
+        mat_vec(b->Ib_inv, Linv, wb);
+        mat_vec(b->R, wb, b->wt);
+        const double speed = sqrt(b->wt[0] * b->wt[0] + b->wt[1] * b->wt[1] +
+                                  b->wt[2] * b->wt[2]);
+        if (speed > 0) {
+            const double axis[3] = {b->wt[0] / speed, b->wt[1] / speed, b->wt[2] / speed};
+            double dR[9];
+            mf_rotation_matrix(axis, speed * dt, dR);
+            mat_mul(dR, b->R, b->Rt);
+        } else {
+            memcpy(b->Rt, b->R, sizeof b->R);
+        }
+        for (int c = 0; c < 3; c++) {
+            a[c] = dt > 0 ? (b->vt[c] - b->v[c]) / dt : 0;
+            dw[c] = dt > 0 ? (b->wt[c] - b->w[c]) / dt : 0;
+        }
+        to_state(w, b->xt, b->Rt, b->vt, b->wt, a, dw);
+    }
+}
+
+void mf_bodies_clear_forces(mf_walls *ws)
+{
+    for (size_t k = 0; ws && k < ws->n; k++)
+        if (ws->w[k].body) {
+            memset(ws->w[k].force, 0, sizeof ws->w[k].force);
+            memset(ws->w[k].torque, 0, sizeof ws->w[k].torque);
+        }
+}
+
+void mf_body_add_force(mf_wall *w, const double x[3], const double f[3])
+{
+    const double *c = w->body->xt; /* the centre where the step has it */
+    const double r[3] = {x[0] - c[0], x[1] - c[1], x[2] - c[2]};
+    double t[3];
+    cross(r, f, t);
+    for (int a = 0; a < 3; a++) {
+        w->force[a] += f[a];
+        w->torque[a] += t[a];
+    }
+}
+
+/* Orientation as a unit quaternion (w x y z) from R (Shepperd's method). */
+static void quaternion(const double R[9], double q[4])
+{
+    const double tr = R[0] + R[4] + R[8];
+    if (tr > 0) {
+        const double s = 2 * sqrt(tr + 1);
+        q[0] = 0.25 * s;
+        q[1] = (R[7] - R[5]) / s;
+        q[2] = (R[2] - R[6]) / s;
+        q[3] = (R[3] - R[1]) / s;
+    } else if (R[0] > R[4] && R[0] > R[8]) {
+        const double s = 2 * sqrt(1 + R[0] - R[4] - R[8]);
+        q[0] = (R[7] - R[5]) / s;
+        q[1] = 0.25 * s;
+        q[2] = (R[1] + R[3]) / s;
+        q[3] = (R[2] + R[6]) / s;
+    } else if (R[4] > R[8]) {
+        const double s = 2 * sqrt(1 + R[4] - R[0] - R[8]);
+        q[0] = (R[2] - R[6]) / s;
+        q[1] = (R[1] + R[3]) / s;
+        q[2] = 0.25 * s;
+        q[3] = (R[5] + R[7]) / s;
+    } else {
+        const double s = 2 * sqrt(1 + R[8] - R[0] - R[4]);
+        q[0] = (R[3] - R[1]) / s;
+        q[1] = (R[2] + R[6]) / s;
+        q[2] = (R[5] + R[7]) / s;
+        q[3] = 0.25 * s;
+    }
+}
+
+static void write_row(const mf_wall *w, double t)
+{
+    const mf_body *b = w->body;
+    if (!b->csv)
+        return;
+    double q[4];
+    quaternion(b->R, q);
+    fprintf(b->csv,
+            "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,"
+            "%.9g,%.9g,%.9g,%.9g\n",
+            t, b->x[0], b->x[1], b->x[2], q[0], q[1], q[2], q[3], b->v[0], b->v[1], b->v[2],
+            b->w[0], b->w[1], b->w[2], w->force[0], w->force[1], w->force[2], w->torque[0],
+            w->torque[1], w->torque[2]);
+    fflush(b->csv);
+}
+
+int mf_bodies_accept(mf_walls *ws, double t, double dt)
+{
+    for (size_t k = 0; ws && k < ws->n; k++) {
+        mf_wall *w = &ws->w[k];
+        mf_body *b = w->body;
+        if (!b)
+            continue;
+        memcpy(b->x, b->xt, sizeof b->x);
+        memcpy(b->v, b->vt, sizeof b->v);
+        memcpy(b->R, b->Rt, sizeof b->R);
+        memcpy(b->L, b->Lt, sizeof b->L);
+        memcpy(b->w, b->wt, sizeof b->w);
+        for (int c = 0; c < 3; c++) {
+            b->J[c] = dt * w->force[c];
+            b->H[c] = dt * w->torque[c];
+        }
+        if (ws->dim == 2)
+            b->J[2] = b->H[0] = b->H[1] = 0;
+        w->state_time = t;
+        if (!(isfinite(b->x[0]) && isfinite(b->x[1]) && isfinite(b->v[0]) && isfinite(b->v[1])))
+            return MF_ERROR(MF_ERR_NUMERIC, "rigid body '%s' at time %g: its state is not "
+                            "finite", w->name, t);
+        write_row(w, t);
+    }
+    return 0;
+}
+
+int mf_bodies_open_output(mf_walls *ws, const char *post_dir, double t)
+{
+    if (mf_bodies_count(ws) == 0)
+        return 0;
+    MF_CALL(mf_mkdir_p(post_dir));
+    char path[4400];
+    for (size_t k = 0; k < ws->n; k++) {
+        mf_wall *w = &ws->w[k];
+        mf_body *b = w->body;
+        if (!b)
+            continue;
+        snprintf(path, sizeof path, "%s/%s", post_dir, w->name);
+        MF_CALL(mf_mkdir_p(path));
+        snprintf(path, sizeof path, "%s/%s/bodyState.csv", post_dir, w->name);
+        if (b->csv)
+            fclose(b->csv);
+        b->csv = fopen(path, "w");
+        if (!b->csv)
+            return MF_ERROR(MF_ERR_IO, "cannot write %s: %s", path, strerror(errno));
+        fprintf(b->csv, "# rigid body '%s': mass %.9g (2-D: per metre), centre of mass, "
+                "orientation (quaternion w x y z), velocity, angular velocity, the fluid's force "
+                "and torque about the centre over the step\n", w->name, b->mass);
+        fprintf(b->csv, "time,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz,Fx,Fy,Fz,Tx,Ty,Tz\n");
+        write_row(w, t);
+    }
+    return 0;
+}
+
+void mf_body_get(const mf_wall *w, mf_body_momentum *out)
+{
+    const mf_body *b = w->body;
+    memset(out, 0, sizeof *out);
+    if (!b)
+        return;
+    out->mass = b->mass;
+    memcpy(out->rotation, b->R, sizeof out->rotation);
+    for (int c = 0; c < 3; c++) {
+        out->centre[c] = b->x[c];
+        out->velocity[c] = b->v[c];
+        out->omega[c] = b->w[c];
+        out->momentum[c] = b->mass * b->v[c];
+        out->angular[c] = b->L[c];
+        out->impulse[c] = b->J[c];
+        out->angular_impulse[c] = b->H[c];
+    }
+}
+
+/* Depth of body point xb below each face of a box (xmin xmax ymin ...). */
+static void face_depths(const mf_wall *w, int dim, const double xb[3], double depth[6])
+{
+    for (int a = 0; a < 3; a++) {
+        depth[2 * a] = a < dim ? xb[a] - w->min[a] : INFINITY;
+        depth[2 * a + 1] = a < dim ? w->max[a] - xb[a] : INFINITY;
+    }
+}
+
+int mf_body_surface_prepare(mf_wall *w, const mf_particles *p, int f_wall_id, int index,
+                            double l0)
+{
+    mf_body *b = w->body;
+    if (b->surface_ready)
+        return 0;
+    const int dim = w->dim;
+    const int32_t *id = mf_particles_fi(p, f_wall_id);
+    double count[6] = {0, 0, 0, 0, 0, 0}, nround = 0;
+    for (size_t i = 0; i < p->n_owned; i++) {
+        if (id[i] != index + 1 || p->kind[i] != MF_WALL)
+            continue;
+        double xb[3], depth[6];
+        mf_wall_to_body(w, &p->pos[3 * i], xb);
+        nround++;
+        face_depths(w, dim, xb, depth);
+        for (int f = 0; f < 2 * dim; f++)
+            count[f] += depth[f] < l0;
+    }
+    if (w->shape == MF_SOLID_BOX) {
+        for (int f = 0; f < 2 * dim; f++) {
+            double area = 1;
+            for (int a = 0; a < dim; a++)
+                if (a != f / 2)
+                    area *= w->max[a] - w->min[a];
+            if (count[f] == 0)
+                return MF_ERROR(MF_ERR_INPUT, "%s: rigid body '%s': no wall particle on a face: "
+                                "make it at least two particle spacings wide", w->where, w->name);
+            b->face_area[f] = area / count[f];
+        }
+    } else if (w->shape == MF_SOLID_SPHERE || (w->shape == MF_SOLID_CYLINDER && dim == 2)) {
+        const double r = w->radius;
+        const double area = dim == 2 ? 2 * M_PI * r : 4 * M_PI * r * r;
+        if (nround == 0)
+            return MF_ERROR(MF_ERR_INPUT, "%s: rigid body '%s' has no wall particle", w->where,
+                            w->name);
+        b->round_area = area / nround;
+    } else {
+        return MF_ERROR(MF_ERR_INPUT, "%s: rigid body '%s': the fluid's pressure on it is "
+                        "summed for boxes, disks and spheres only so far (a 3-D cylinder or a "
+                        "mesh is not yet)", w->where, w->name);
+    }
+    b->surface_ready = true;
+    return 0;
+}
+
+int mf_body_surface(const mf_wall *w, const double x[3], double l0, double out_area[3][3],
+                    double out_shift[3][3])
+{
+    const mf_body *b = w->body;
+    const int dim = w->dim;
+    double xb[3];
+    mf_wall_to_body(w, x, xb);
+    int n = 0;
+    double nb[3] = {0, 0, 0}, db = 0;
+    if (w->shape == MF_SOLID_BOX) {
+        double depth[6];
+        face_depths(w, dim, xb, depth);
+        for (int f = 0; f < 2 * dim && n < 3; f++) {
+            if (!(depth[f] < l0))
+                continue;
+            memset(nb, 0, sizeof nb);
+            nb[f / 2] = f % 2 ? 1 : -1;
+            db = depth[f];
+            mat_vec(w->state.R, nb, out_area[n]);
+            for (int a = 0; a < 3; a++) {
+                out_shift[n][a] = db * out_area[n][a];
+                out_area[n][a] *= b->face_area[f];
+            }
+            n++;
+        }
+        return n;
+    }
+    double r2 = 0;
+    for (int a = 0; a < dim; a++)
+        r2 += (xb[a] - w->centre[a]) * (xb[a] - w->centre[a]);
+    const double r = sqrt(r2);
+    if (!(r > 0))
+        return 0;
+    for (int a = 0; a < dim; a++)
+        nb[a] = (xb[a] - w->centre[a]) / r;
+    mat_vec(w->state.R, nb, out_area[0]);
+    for (int a = 0; a < 3; a++) {
+        out_shift[0][a] = (w->radius - r) * out_area[0][a];
+        out_area[0][a] *= b->round_area;
+    }
+    return 1;
+}

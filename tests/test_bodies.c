@@ -1,0 +1,265 @@
+/* test_bodies.c: rigid bodies moved by the fluid (issue 18; core/scene/
+ * mf_bodies.h, solvers/solver/mps/mps_bodies.c).
+ *
+ *   momentum   a free blob of water (no gravity) in a closed box, never
+ *              touching its walls, with a neutrally buoyant box body in it
+ *              set moving at U: the total momentum of fluid and body,
+ *                P = sum_i m_i u_i + m_b v_b + J,
+ *              (J the impulse the body has received but not yet taken, the
+ *              step's force times its dt) stays what it was. The scheme is
+ *              the one whose pair forces are all antisymmetric (gradient
+ *              corrected, the CMPS pair term of Khayyer & Gotoh 2008; the
+ *              eq. 7 Laplacian; no collision model, no shifting): the fluid
+ *              alone conserves its momentum, and the body receives the exact
+ *              reaction of the pressure and viscous pair forces the fluid
+ *              received from its particles (mps_bodies.c). What is left is
+ *              round-off and the 9 significant digits of bodyState.csv's
+ *              velocity and force: |P(t) - P(0)| <= MOMENTUM_TOL P(0), with
+ *              MOMENTUM_TOL = 1e-8 (10 ulp of the CSV's digits; a wrong sign,
+ *              factor or one-step lag of the exchange is an error of order
+ *              the impulse exchanged, 0.4 P(0) here);
+ *   snapshot   the last snapshot holds the body's state (/RigidBodies/body):
+ *              its Velocity is the CSV's at that time (to the CSV's digits);
+ *   at rest    the same body with the blob at rest stays at rest (no force
+ *              from nothing): |v_b| below 1e-6 m/s.
+ *
+ * argv[1]: mpsflow. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <hdf5.h>
+
+#include "case_util.h"
+#include "mf_test.h"
+
+#define L0 0.01
+#define MOMENTUM_TOL 1e-8 /* of P(0): the CSV's 9 significant digits */
+
+static const char *const control =
+    "endTime 0.2;\ndeltaT 1e-4;\nadjustTimeStep yes;\nmaxCo 0.2;\nmaxDeltaT 1e-3;\n"
+    "writeControl adjustableRunTime;\nwriteInterval 0.02;\n";
+static const char *const fluids = "water { rho 1000; nu 1e-4; }\n";
+static const char *const solver =
+    "solver MPS;\n"
+    "MPSCoeffs { gradient corrected; laplacian paper; collision no; shifting none; }\n"
+    "pressure { solver PCG_BoomerAMG; tolerance 1e-10; }\n";
+
+/* A blob 0.2 m square around a box body 0.06 m square, in a closed tank
+ * 0.4 m square. */
+static void geometry(char *out, size_t len, double u)
+{
+    snprintf(out, len,
+             "dimension 2;\nparticleSpacing %g;\n"
+             "fluidBlocks {\n"
+             " a { type box; min (0.1 0.1 0); max (0.17 0.3 0); fluid water; }\n"
+             " b { type box; min (0.23 0.1 0); max (0.3 0.3 0); fluid water; }\n"
+             " c { type box; min (0.17 0.1 0); max (0.23 0.17 0); fluid water; }\n"
+             " d { type box; min (0.17 0.23 0); max (0.23 0.3 0); fluid water; }\n}\n"
+             "walls { tank { type box; min (0 0 0); max (0.4 0.4 0); } }\n"
+             "obstacles { body { type box; min (0.17 0.17 0); max (0.23 0.23 0);\n"
+             " motion { type rigid; density 1000; g (0 0 0); velocity (%g 0 0); } } }\n",
+             L0, u);
+}
+
+/* Rows of bodyState.csv: time, velocity (vx vy), force (Fx Fy). */
+typedef struct track {
+    size_t n;
+    double *t, *v, *f; /* n, 2n, 2n */
+    double mass;
+} track;
+
+static int read_track(const char *dir, track *tr)
+{
+    char path[1024];
+    snprintf(path, sizeof path, "%s/postProcessing/body/bodyState.csv", dir);
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return -1;
+    memset(tr, 0, sizeof *tr);
+    size_t cap = 0;
+    char line[4096];
+    while (fgets(line, sizeof line, f)) {
+        if (line[0] == '#') {
+            const char *m = strstr(line, "mass ");
+            if (m)
+                tr->mass = atof(m + 5);
+            continue;
+        }
+        double c[20];
+        int k = 0;
+        for (char *s = line, *e; k < 20; k++, s = e + 1) {
+            c[k] = strtod(s, &e);
+            if (e == s || (*e != ',' && k < 19))
+                break;
+        }
+        if (k < 19)
+            continue;
+        if (tr->n == cap) {
+            cap = cap ? 2 * cap : 256;
+            tr->t = realloc(tr->t, cap * sizeof *tr->t);
+            tr->v = realloc(tr->v, 2 * cap * sizeof *tr->v);
+            tr->f = realloc(tr->f, 2 * cap * sizeof *tr->f);
+            if (!tr->t || !tr->v || !tr->f) {
+                fclose(f);
+                return -1;
+            }
+        }
+        tr->t[tr->n] = c[0];
+        tr->v[2 * tr->n] = c[8];
+        tr->v[2 * tr->n + 1] = c[9];
+        tr->f[2 * tr->n] = c[14];
+        tr->f[2 * tr->n + 1] = c[15];
+        tr->n++;
+    }
+    fclose(f);
+    return tr->n > 1 && tr->mass > 0 ? 0 : -1;
+}
+
+static void track_free(track *tr)
+{
+    free(tr->t);
+    free(tr->v);
+    free(tr->f);
+}
+
+/* Attribute `name` (n doubles) of /RigidBodies/<body> in snapshot `path`. */
+static int body_attribute(const char *path, const char *body, const char *name, double *v)
+{
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    if (f < 0)
+        return -1;
+    char obj[256];
+    snprintf(obj, sizeof obj, "/RigidBodies/%s", body);
+    int rc = -1;
+    hid_t a = H5Aopen_by_name(f, obj, name, H5P_DEFAULT, H5P_DEFAULT);
+    if (a >= 0) {
+        rc = H5Aread(a, H5T_NATIVE_DOUBLE, v) < 0 ? -1 : 0;
+        H5Aclose(a);
+    }
+    H5Fclose(f);
+    return rc;
+}
+
+static bool run(tc_case *c, const char *what)
+{
+    int status = tc_case_run(c, NULL, NULL);
+    CHECK_MSG(status == 0, "%s: mpsflow exited with %d", what, status);
+    if (status != 0)
+        tc_case_log_tail(c, 20);
+    return status == 0;
+}
+
+static void check_momentum(const char *exe)
+{
+    const double U = 0.05;
+    char geo[2048];
+    geometry(geo, sizeof geo, U);
+    tc_case c;
+    CHECK_OK(tc_case_from_strings(&c, exe, "bodies-momentum", control, solver, fluids, geo));
+    track tr;
+    bool ok = run(&c, "momentum");
+    if (ok) {
+        ok = read_track(c.dir, &tr) == 0;
+        CHECK_MSG(ok, "momentum: no postProcessing/body/bodyState.csv with rows");
+    }
+    if (ok) {
+        tc_snapshots s;
+        CHECK_OK(tc_snapshots_list(c.dir, &s));
+        const double P0 = tr.mass * U;
+        double worst = 0, worst_ratio = 0, impulse = 0;
+        size_t row = 0, checked = 0;
+        for (size_t k = 0; k < s.n; k++) {
+            mf_sim sim;
+            mf_hdf5_header h;
+            if (tc_snapshot_load(c.dir, s.index[k], &sim, &h) != 0)
+                continue;
+            double P[2] = {0, 0};
+            const double m = 1000 * L0 * L0;
+            for (size_t i = 0; i < sim.p->n; i++)
+                if (sim.p->kind[i] == MF_FLUID) {
+                    P[0] += m * sim.p->vel[3 * i];
+                    P[1] += m * sim.p->vel[3 * i + 1];
+                }
+            tc_sim_free(&sim);
+            /* the body's row at this time; the impulse received up to it */
+            while (row + 1 < tr.n && tr.t[row] < h.time * (1 - 1e-12)) {
+                row++;
+                const double dt = tr.t[row] - tr.t[row - 1];
+                impulse += hypot(tr.f[2 * row], tr.f[2 * row + 1]) * dt;
+            }
+            if (fabs(tr.t[row] - h.time) > 1e-9 * fmax(1, h.time))
+                continue;
+            const double dt = row > 0 ? tr.t[row] - tr.t[row - 1] : 0;
+            for (int a = 0; a < 2; a++)
+                P[a] += tr.mass * tr.v[2 * row + a] + tr.f[2 * row + a] * dt;
+            const double err = hypot(P[0] - P0, P[1]);
+            worst = fmax(worst, err);
+            if (impulse > 0)
+                worst_ratio = fmax(worst_ratio, err / impulse);
+            printf("t = %.3f: P = (%.6g %.6g) kg m/s (P(0) = %.6g), body v = %.5f m/s, "
+                   "|P - P(0)| = %.3g = %.3g of the impulse %.4g\n",
+                   h.time, P[0], P[1], P0, tr.v[2 * row], err, impulse > 0 ? err / impulse : 0,
+                   impulse);
+            CHECK_MSG(err <= MOMENTUM_TOL * P0,
+                      "momentum: t = %g: |P - P(0)| = %g above %g P(0) (the impulse exchanged: "
+                      "%g)", h.time, err, MOMENTUM_TOL, impulse);
+            checked++;
+        }
+        if (s.n > 0) {
+            char path[1024];
+            tc_snapshot_path(c.dir, s.index[s.n - 1], path, sizeof path);
+            double v[3] = {NAN, NAN, NAN};
+            CHECK_OK(body_attribute(path, "body", "Velocity", v));
+            const double vl = tr.v[2 * (tr.n - 1)];
+            printf("snapshot: /RigidBodies/body Velocity (%.9g %.9g), the CSV's last row %.9g\n",
+                   v[0], v[1], vl);
+            CHECK(fabs(v[0] - vl) <= 1e-8 * fabs(vl) && fabs(v[1]) < 1e-12);
+        }
+        tc_snapshots_free(&s);
+        CHECK_MSG(checked >= 5, "momentum: only %zu snapshots matched the body's rows", checked);
+        /* the body must have exchanged momentum at all for this to mean anything */
+        CHECK_MSG(tr.v[2 * (tr.n - 1)] < 0.95 * U && impulse > 0.05 * P0,
+                  "momentum: the body kept its velocity (%g of %g m/s): no exchange with the "
+                  "fluid", tr.v[2 * (tr.n - 1)], U);
+        printf("momentum: worst |P - P(0)| %.3g kg m/s = %.3g P(0) (tolerance %.2g P(0)), %.3g of "
+               "the impulse exchanged\n", worst, worst / P0, MOMENTUM_TOL, worst_ratio);
+        track_free(&tr);
+    }
+    tc_case_destroy(&c);
+}
+
+static void check_rest(const char *exe)
+{
+    char geo[2048];
+    geometry(geo, sizeof geo, 0.0);
+    tc_case c;
+    CHECK_OK(tc_case_from_strings(&c, exe, "bodies-rest", control, solver, fluids, geo));
+    track tr;
+    bool ok = run(&c, "at rest");
+    if (ok) {
+        ok = read_track(c.dir, &tr) == 0;
+        CHECK_MSG(ok, "at rest: no postProcessing/body/bodyState.csv with rows");
+    }
+    if (ok) {
+        double vmax = 0;
+        for (size_t k = 0; k < tr.n; k++)
+            vmax = fmax(vmax, hypot(tr.v[2 * k], tr.v[2 * k + 1]));
+        printf("at rest: the body's largest speed %.3g m/s\n", vmax);
+        CHECK(vmax < 1e-6);
+        track_free(&tr);
+    }
+    tc_case_destroy(&c);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        fprintf(stderr, "usage: test_bodies MPSFLOW\n");
+        return 2;
+    }
+    check_momentum(argv[1]);
+    check_rest(argv[1]);
+    return mf_test_summary("bodies");
+}
