@@ -243,6 +243,10 @@ static double wall_energy(const mf_sim *sim)
         else
             u2 = fmax(u2, v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
     }
+    if (sim->walls && !sim->walls->particles) { /* wall weight: the solids themselves */
+        const double u = mf_walls_max_speed(sim->walls, p);
+        u2 = u * u;
+    }
     return 0.5 * mass * u2;
 }
 

@@ -191,7 +191,8 @@ void mf_walls_move_particles(const mf_walls *ws, const mf_rigid_state *from_stat
  * to do (0) without a moving solid. */
 int mf_walls_advance(mf_walls *ws, mf_particles *p, double t_from, double t_to);
 /* The largest speed of a moving solid's particles (0: none), for the
- * Courant limit of the step. */
+ * Courant limit of the step; solids without particles (wall weight): their
+ * largest speed at the fluid particles' positions. */
 double mf_walls_max_speed(const mf_walls *ws, const mf_particles *p);
 
 /* ---- wall weight sums (walls_sums.c) ---------------------------------- */

@@ -292,8 +292,29 @@ int mf_walls_advance(mf_walls *ws, mf_particles *p, double t_from, double t_to)
     return 0;
 }
 
+/* Solids without particles (wall weight): their speed where the fluid is. */
+static double speed_at_fluid(const mf_walls *ws, const mf_particles *p)
+{
+    double u2 = 0;
+    for (size_t k = 0; k < ws->n; k++) {
+        const double *su = ws->w[k].surface_velocity; /* a sliding lid */
+        if (!mf_wall_moves(&ws->w[k]) && su[0] == 0 && su[1] == 0 && su[2] == 0)
+            continue;
+        for (size_t i = 0; i < p->n_owned; i++) {
+            if (p->kind[i] != MF_FLUID)
+                continue;
+            double v[3];
+            mf_wall_velocity(&ws->w[k], &p->pos[3 * i], true, v);
+            u2 = fmax(u2, v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        }
+    }
+    return sqrt(u2);
+}
+
 double mf_walls_max_speed(const mf_walls *ws, const mf_particles *p)
 {
+    if (ws && !ws->particles)
+        return speed_at_fluid(ws, p);
     if (!ws || ws->f_wall_id < 0)
         return 0;
     const int32_t *id = mf_particles_fi(p, ws->f_wall_id);

@@ -88,6 +88,27 @@ static int create_forces(mf_app *app, mf_dict *resolved)
     return 0;
 }
 
+/* Does the solver's Coeffs set `wall wallWeight;`? Read before the scene is
+ * built: the walls then have no particles (sim->wall_weight); the solver
+ * checks the key with the rest of its parameters and refuses it where it
+ * has no wall terms. */
+static bool solver_wants_wall_weight(const mf_app *app)
+{
+    const mf_dict *sd = app->cs.solver_dict;
+    const char *name = app->opt.solver;
+    if (!name && mf_dict_get_word_or(sd, "solver", NULL, &name) != 0)
+        return false;
+    if (!name)
+        return false;
+    char coeffs[256];
+    snprintf(coeffs, sizeof coeffs, "%sCoeffs", name);
+    const mf_dict *cd = mf_dict_subdict(sd, coeffs);
+    const char *wall = NULL;
+    if (!cd || mf_dict_get_word_or(cd, "wall", NULL, &wall) != 0 || !wall)
+        return false;
+    return strcmp(wall, "wallWeight") == 0;
+}
+
 static int create_solver(mf_app *app, mf_dict *resolved)
 {
     const mf_dict *sd = app->cs.solver_dict;
@@ -228,6 +249,7 @@ int mf_app_setup(mf_app *app)
     mesh_reader = mf_mesh_import_reader();
     sim->mesh_reader = &mesh_reader;
     sim->mesh_relative_to = app->cs.geometry->loc.file; /* constant/geometry */
+    sim->wall_weight = solver_wants_wall_weight(app);
     MF_CALL(mf_app_memory_budget(app, &app->budget));
     MF_CALL(mf_scene_build_budgeted(app->cs.geometry, app->opt.l0, sim,
                                     mf_dict_set_subdict(resolved, "geometry"), &mesh_reader,

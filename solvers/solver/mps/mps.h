@@ -55,6 +55,7 @@ typedef struct mps_settings {
     const char *viscosity;    /* "explicit" (eq. 7 term in the explicit phase) or "implicit" */
     double periodic_length;   /* period along x, m (0: no periodic axis) */
     double periodic_origin;   /* x of the periodic box's lower face, m */
+    const char *wall;         /* particles | wallWeight (mps_wall.c) */
 } mps_settings;
 
 /* Pair averages: mf_inv_rho_pair, mf_mu_pair (mf_kernel.h); mps_data's
@@ -160,14 +161,18 @@ typedef struct mps_data {
      * in a serial run without a period. While a step runs, particles
      * [n_owned, n) are copies. */
     struct mps_halo *halo;
+    /* `wall wallWeight;` (mps_wall.c): the walls' terms; NULL with wall
+     * particles (the walls are particles and the step is unchanged). */
+    struct mps_wall *wall;
 } mps_data;
 
 enum { MPS_FLAG_SURFACE = 1 }; /* bits of the Flags field */
 
 extern const mf_solver_ops mf_solver_MPS;
-#define MPS_NPARAMS 27 /* checked against the table in mps_params.c */
+#define MPS_NPARAMS 28 /* checked against the table in mps_params.c */
 extern const mf_param mps_params[MPS_NPARAMS];
 extern const char *const mps_viscosity_choices[]; /* explicit, implicit */
+extern const char *const mps_wall_choices[];      /* particles, wallWeight */
 /* mps_scheme.c */
 extern const char *const mps_scheme_choices[], *const mps_source_choices[],
     *const mps_gradient_choices[], *const mps_laplacian_choices[], *const mps_shifting_choices[],
@@ -254,6 +259,9 @@ extern const char *const mps_scheme_choices[], *const mps_source_choices[],
      "period along x, m (0: none); the walls must be open at xmin and xmax"},                    \
     {"periodicOrigin", MF_PARAM_SCALAR, "0", -1e9, 1e9, NULL, OFF(periodic_origin),             \
      "x of the periodic box's lower face, m"},                                                   \
+    {"wall", MF_PARAM_WORD, "particles", MF_NO_RANGE, mps_wall_choices, OFF(wall),                \
+     "walls: particles (wall and dummy particles) or wallWeight (no particles: wall weight "      \
+     "functions, Harada et al. 2008, no slip and no penetration on the wall face; solver MPS)"}, \
 
 
 /* mps_module.c */
@@ -380,5 +388,32 @@ int mps_halo_sync_motion(const mps_data *d, const mf_sim *sim);
  * is global (mf_rows.global_col). */
 int mps_global_rows(const mps_data *d, const mf_sim *sim, long *row, size_t nrows,
                     long *global, int64_t *offset, int64_t *nglobal, const long **global_col);
+
+/* mps_wall.c: `wall wallWeight;`, the walls' part of each operator from the
+ * wall weight tables (each a function of core/particles/mf_wall_terms.h
+ * over the owned fluid particles). Nothing of it runs with wall particles
+ * (d->wall NULL). */
+/* An error naming where `wall` was set, with why (0 when s says particles). */
+int mps_wall_refuse(const mps_settings *s, const mf_dict *solver_dict, const char *why);
+/* The tables and work arrays (nothing with wall particles); refuses the
+ * choices the terms do not cover. */
+int mps_wall_create(mps_data *d, mf_sim *sim, const mf_dict *solver_dict);
+void mps_wall_destroy(struct mps_wall *w);
+/* The wall weight sums of the owned fluid particles at their positions. */
+int mps_wall_points(mps_data *d, const mf_sim *sim);
+/* d->acc (the forces only) kept for the pressure continued into the walls. */
+void mps_wall_keep_forces(mps_data *d, const mf_sim *sim);
+/* After the explicit update (u = u*): across each wall face the forces'
+ * acceleration replaced by (u* - u_w).n / dt. */
+void mps_wall_keep_approach(mps_data *d, const mf_sim *sim, double dt);
+void mps_wall_number_density(const mps_data *d, const mf_sim *sim, double *n);
+void mps_wall_viscous(mps_data *d, const mf_sim *sim, double nu);              /* into d->acc */
+void mps_wall_divergence(const mps_data *d, const mf_sim *sim, const uint8_t *imask,
+                         double *div);
+/* Into d->grad; phat: p^ of eq. 5 (the neighbourhood's minimum or p). */
+void mps_wall_gradient(const mps_data *d, const mf_sim *sim, const double *pressure,
+                       const double *phat, double rho);
+int mps_wall_collide(mps_data *d, mf_sim *sim, double dt);                    /* against faces */
+void mps_wall_report(const struct mps_wall *w, mf_log *log);
 
 #endif

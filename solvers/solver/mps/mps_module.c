@@ -126,6 +126,11 @@ int mps_create_data(const mps_settings *s, mf_sim *sim, const mf_dict *solver_di
 {
     if (s->periodic_length > 0)
         return MF_ERROR(MF_ERR_INPUT, "periodicLength: only solver MPS has a periodic axis");
+    /* mps_create takes the key away for solver MPS; a composing solver
+     * (MAFL's Eulerian points, multiFluid's density per particle) has no
+     * wall terms yet. */
+    MF_CALL(mps_wall_refuse(s, solver_dict, "only solver MPS takes its walls through wall "
+                                             "weight functions yet"));
     mps_data *d = calloc(1, sizeof *d);
     if (!d)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory");
@@ -179,6 +184,7 @@ void mps_destroy_data(mps_data *d)
     mf_module_release(&d->pressure);
     mps_viscosity_destroy(d->visc);
     mps_halo_destroy(d->halo);
+    mps_wall_destroy(d->wall);
     free(d->acc);
     free(d->grad);
     free(d->is_fluid);
@@ -209,7 +215,9 @@ static int mps_create(const void *settings, mf_sim *sim, const mf_dict *solver_d
      * solvers call the phases themselves. */
     mps_settings s = *(const mps_settings *)settings;
     const double period = s.periodic_length;
+    const char *wall = s.wall;
     s.periodic_length = 0;
+    s.wall = "particles";
     mps_data *d = NULL;
     int rc = mps_create_data(&s, sim, solver_dict, &d);
     if (rc == 0 && period > 0) { /* the halo of mps_create_data gains the period */
@@ -217,6 +225,10 @@ static int mps_create(const void *settings, mf_sim *sim, const mf_dict *solver_d
         d->halo = NULL;
         d->s.periodic_length = period;
         rc = mps_halo_create(d, sim);
+    }
+    if (rc == 0) { /* wall wallWeight: the walls' terms (mps_wall.c) */
+        d->s.wall = wall;
+        rc = mps_wall_create(d, sim, solver_dict);
     }
     if (rc != 0) {
         mps_destroy_data(d);
@@ -280,6 +292,7 @@ static void mps_report(void *data, const mf_sim *sim, mf_log *log)
                   nb.builds, nb.sorts, d->attempts, nb.entries,
                   mf_neighbours_memory(d->nb) / 1048576.0);
     mps_viscosity_report(d->visc, sim, log);
+    mps_wall_report(d->wall, log);
 }
 
 const mf_solver_ops mf_solver_MPS = {

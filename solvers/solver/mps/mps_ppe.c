@@ -205,8 +205,8 @@ static bool ppe_row(const void *ctx, size_t i, size_t r)
     const size_t diag = c->rows.rowptr[r];
     const double sum = mf_pairs_row_assemble(&c->v, i, d->not_dummy, NULL, ppe_coef, ppe_known,
                                              c, &acc, &c->rows, r);
-    if (!(sum > 0) && d->is_fluid[i])
-        return false;
+    if (!(sum > 0) && d->is_fluid[i] && !d->wall)
+        return false; /* (wall weight: a particle with only the wall near takes p = 0 below) */
     const double dt2 = c->dt * c->dt;
     /* n* - n0, or against a per-particle reference (mps_data.n_offset) */
     const double dn = d->n_offset ? c->n[i] - c->n0 - d->n_offset[i] : c->n[i] - c->n0;

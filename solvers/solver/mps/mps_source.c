@@ -47,6 +47,8 @@ int mps_source_start(mps_data *d, mf_sim *sim)
     mf_pairs v;
     MF_CALL(mps_pairs(d, sim, d->h_nd, &v));
     mf_number_density(&v, d->not_dummy, NULL, d->n_start);
+    if (d->wall) /* the walls' share at r^n (mps_wall.c) */
+        mps_wall_number_density(d, sim, d->n_start);
     if (src == MPS_SOURCE_ERROR_COMPENSATING)
         mf_number_density_rate(&v, sim->p->vel, d->not_dummy, NULL, d->rate_start);
     return 0;
@@ -66,6 +68,8 @@ int mps_source_terms(mps_data *d, const mf_sim *sim, double dt)
         /* eq. 6 at the gradient's radius over the particles the gradient sees */
         MF_CALL(mps_pairs(d, sim, d->h_grad, &v));
         mf_divergence(&v, &d->k_grad, p->vel, d->in_ppe, d->not_dummy, rate);
+        if (d->wall) /* the walls' velocity */
+            mps_wall_divergence(d, sim, d->in_ppe, rate);
         const double gamma = d->s.density_factor * scale;
         for (size_t i = 0; i < p->n_owned; i++)
             if (d->in_ppe[i])

@@ -138,10 +138,13 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
     const double nu = sim->fluid[0].nu;
     retry_scale(d, sim, dt);
     /* The mixed source's n at r^n rides in the viscous term's pass when both
-     * are eq. 3's sums over the same pairs (the same values, one pass). */
-    const bool nd_with_viscosity = !d->visc && !d->mu && nu > 0 &&
+     * are eq. 3's sums over the same pairs (the same values, one pass); not
+     * with wall weight, whose share is added to n at r^n (mps_wall.c). */
+    const bool nd_with_viscosity = !d->visc && !d->mu && !d->wall && nu > 0 &&
                                    d->sc.laplacian == MPS_LAPLACIAN_PAPER &&
                                    d->sc.source == MPS_SOURCE_MIXED && d->k_nd.re == d->k_lap.re;
+    if (d->wall) /* wall weight: the walls' sums at r^n */
+        MF_CALL(mps_wall_points(d, sim));
     if (nd_with_viscosity)
         MF_CALL(mps_scheme_reserve(d, p->n));
     else
@@ -149,6 +152,8 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
     mps_bodies_begin(d, sim);
     memset(d->acc, 0, 3 * p->n * sizeof *d->acc);
     MF_CALL(mf_force_accumulate(sim, d->acc));
+    if (d->wall) /* the force acceleration continues the pressure into the walls */
+        mps_wall_keep_forces(d, sim);
     if (d->visc) { /* viscosity implicit: u* = (I - dt nu lap)^-1 (u + dt a), r* = r + dt u* */
         MF_CALL(mps_viscosity_implicit(d, sim, dt));
     } else if ((d->mu || nu > 0) && d->sc.laplacian != MPS_LAPLACIAN_PAPER) {
@@ -165,6 +170,8 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
         else
             mf_laplacian_add(&v, &d->k_lap, p->vel, nu, d->is_fluid, NULL, d->acc);
     }
+    if (d->wall && nu > 0) /* no slip on the walls' faces */
+        mps_wall_viscous(d, sim, nu);
     MF_CALL(mps_bodies_viscous(d, sim)); /* the rigid bodies' share, at r^n */
     for (size_t i = 0; i < p->n_owned && !d->visc; i++) {
         if (!d->is_fluid[i])
@@ -174,10 +181,14 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
             p->pos[3 * i + c] += dt * p->vel[3 * i + c];
         }
     }
+    if (d->wall) /* u*: what the wall's pressure will stop (mps_wall.c) */
+        mps_wall_keep_approach(d, sim, dt);
     if (d->halo) /* copies move with their owners (the collision model reads them) */
         MF_CALL(mps_halo_sync_motion(d, sim));
     if (d->s.collision)
         MF_CALL(collide(d, sim, dt));
+    if (d->s.collision && d->wall)
+        MF_CALL(mps_wall_collide(d, sim, dt));
     d->t_explicit += mf_wall_seconds() - t0;
     return 0;
 }
@@ -231,14 +242,21 @@ int mps_surface_phase(mps_data *d, mf_sim *sim)
     mf_pairs v;
     MF_CALL(mps_pairs(d, sim, d->h_nd, &v));
     const double n0 = d->k_nd.n0;
-    if (d->sc.detection == MPS_DETECT_ASYMMETRY) {
-        /* n* of the particles and the fluid's asymmetry in one pass */
+    const bool asymmetry = d->sc.detection == MPS_DETECT_ASYMMETRY;
+    if (asymmetry)
         MF_CALL(mps_scheme_reserve(d, p->n));
+    if (asymmetry && !d->wall) /* n* of the particles and the fluid's asymmetry in one pass */
         mf_number_density_asymmetry(&v, &d->k_nd, d->not_dummy, d->is_fluid, n, d->work);
-        MF_CALL(detect_by_asymmetry(d, sim));
-    } else {
+    else
         mf_number_density(&v, d->not_dummy, NULL, n);
+    if (d->wall) { /* the walls' sums at r*, their number density */
+        MF_CALL(mps_wall_points(d, sim));
+        mps_wall_number_density(d, sim, n);
+        if (asymmetry) /* after the walls' sums, which may use the scratch */
+            mf_neighbour_asymmetry(&v, &d->k_nd, d->is_fluid, NULL, d->work);
     }
+    if (asymmetry)
+        MF_CALL(detect_by_asymmetry(d, sim));
     for (size_t i = 0; i < p->n_owned; i++) {
         bool surface = d->sc.detection == MPS_DETECT_ASYMMETRY
                            ? d->flag_work[i]
@@ -296,6 +314,12 @@ int mps_correction_phase(mps_data *d, mf_sim *sim, double dt)
     mf_gradient(&v, &d->k_grad, pr, d->s.gradient_pmin, d->is_fluid, d->not_dummy, d->grad);
     MF_CALL(mps_bodies_pressure(d, sim, pr)); /* the rigid bodies' share, at r* */
     const double rho = sim->fluid[0].rho;
+    if (d->wall) { /* the walls' part, with eq. 5's p^ of each particle */
+        MF_CALL(mps_scheme_reserve(d, p->n));
+        double *phat = d->work;
+        mf_neighbour_min(&v, pr, d->s.gradient_pmin, NULL, d->is_fluid, d->not_dummy, phat);
+        mps_wall_gradient(d, sim, pr, phat, rho);
+    }
     for (size_t i = 0; i < p->n_owned; i++) {
         if (!d->is_fluid[i])
             continue;
