@@ -15,8 +15,10 @@ with
     h(n)      = F/6 ((n^(1/3) + 2k)^3 - n)   copies around a cube of n
                                               particles, k spacings deep, F =
                                               min(6, log2 P) faces on other ranks
-    s_solve   = f c n I(P) / I(1)            the PPE's share f of the work,
-                                              iterations I(P) = I(1)(1 + a log2 P)
+    s_solve   = f c n q I(P) / I(1)          the PPE's share f of the work,
+                                              iterations I(P) = I(1)(1 + a log2 P),
+                                              q (P > 1) the solve's work a row
+                                              on N ranks over the serial's
     t_halo    = E m alpha + h b / beta       E exchanges a step, m = min(26,
                                               P - 1) neighbours, b bytes a copy
                                               a step (all exchanges)
@@ -39,7 +41,8 @@ def model(args, N, P):
     m = min(args.m, P - 1)
     iters = args.iters * (1 + args.a * math.log2(P)) if P > 1 else args.iters
     comp = args.c * (n * (1 - args.f) + args.g * h)
-    solve = args.f * args.c * n * iters / args.iters
+    q = args.q if P > 1 else 1.0
+    solve = args.f * args.c * n * q * iters / args.iters
     lg = math.log2(P) if P > 1 else 0.0
     halo = args.exchanges * m * args.alpha + h * args.bytes / args.beta if P > 1 else 0.0
     reduce = (args.R + args.r * iters) * args.alpha_r * lg
@@ -56,6 +59,9 @@ def main():
     ap.add_argument("--f", type=float, default=0.5, help="the PPE solve's share of a serial step")
     ap.add_argument("--g", type=float, default=0.5, help="cost of a halo copy / an owned particle")
     ap.add_argument("--k", type=float, default=3.1, help="halo depth in spacings (largest radius)")
+    ap.add_argument("--q", type=float, default=2.75,
+                    help="the solve's work a row on N ranks over the serial's (hypre's hierarchy "
+                         "set up each solve against the serial V-cycle's kept one; 1: the same)")
     ap.add_argument("--iters", type=float, default=9.2, help="PCG iterations on one rank")
     ap.add_argument("--a", type=float, default=0.05, help="iteration growth per doubling of P")
     ap.add_argument("--exchanges", type=float, default=8, help="halo builds + updates + migration a step")

@@ -452,3 +452,36 @@ int tc_resolved_number(const char *case_dir, const char *key_path, double *out)
     mf_dict_free(root);
     return rc;
 }
+
+char *tc_read_text(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    char *s = n >= 0 ? malloc((size_t)n + 1) : NULL;
+    if (s && fread(s, 1, (size_t)n, f) != (size_t)n) {
+        free(s);
+        s = NULL;
+    }
+    if (s)
+        s[n] = '\0';
+    fclose(f);
+    return s;
+}
+
+char *tc_with_forces(const char *text, const char *forces)
+{
+    const char *at = text ? strstr(text, "\nforces") : NULL;
+    if (!at)
+        return NULL;
+    const size_t head = (size_t)(at - text) + 1;
+    char *out = malloc(head + strlen(forces) + 1);
+    if (out) {
+        memcpy(out, text, head);
+        strcpy(out + head, forces);
+    }
+    return out;
+}

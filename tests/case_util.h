@@ -51,6 +51,14 @@ int tc_case_from_dir(tc_case *c, const char *exe, const char *tag, const char *s
 /* Write (replace) a file of the case, `rel` relative to its folder. */
 int tc_case_write(const tc_case *c, const char *rel, const char *text);
 
+/* A whole file as a string (malloc'd; NULL if it cannot be read). */
+char *tc_read_text(const char *path);
+
+/* A solverDict's text with its forces block (from the line starting
+ * "forces" to the end) replaced by `forces` (malloc'd; NULL when the text
+ * has no such line). */
+char *tc_with_forces(const char *text, const char *forces);
+
 /* Run `mpsflow [command] -case DIR args...` (command NULL or "run": a plain
  * run; "validate": the validate command). args is NULL-terminated, may be
  * NULL. stdout and stderr are appended to DIR/log, each run headed by its

@@ -47,25 +47,6 @@
  * lags by about |V| / rate = 4 mm while it moves (measured: 1.8 mm). */
 #define LAG_TOL (0.5 * L0)
 
-static char *read_text(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *s = malloc((size_t)n + 1);
-    if (s && fread(s, 1, (size_t)n, f) != (size_t)n) {
-        free(s);
-        s = NULL;
-    }
-    if (s)
-        s[n] = '\0';
-    fclose(f);
-    return s;
-}
-
 /* The text without the lines from the one holding "control begin" to the one
  * holding "control end" (what the tutorial's Allrun does with sed). */
 static char *without_control(const char *text)
@@ -94,20 +75,6 @@ static char *without_control(const char *text)
 
 /* The solver dictionary text with its forces block (the last part of the
  * file, as the tutorial writes it) replaced by `forces` (malloc'ed). */
-static char *with_forces(const char *text, const char *forces)
-{
-    const char *at = text ? strstr(text, "\nforces") : NULL;
-    if (!at)
-        return NULL;
-    const size_t head = (size_t)(at - text) + 1;
-    char *out = malloc(head + strlen(forces) + 1);
-    if (out) {
-        memcpy(out, text, head);
-        strcpy(out + head, forces);
-    }
-    return out;
-}
-
 /* The fluid particles' fraction inside the box [lo, hi] (2-D). */
 static double fraction_in_box(const mf_particles *p, const double lo[2], const double hi[2])
 {
@@ -180,7 +147,7 @@ static void check_directed_splash(const char *exe, const char *tutorial)
 {
     char path[1024];
     snprintf(path, sizeof path, "%s/system/solverDict", tutorial);
-    char *solver = read_text(path);
+    char *solver = tc_read_text(path);
     CHECK_MSG(solver != NULL, "%s: cannot read", path);
     if (!solver)
         return;
@@ -192,11 +159,11 @@ static void check_directed_splash(const char *exe, const char *tutorial)
     CHECK_OK(tc_case_write(&unc, TC_SOLVER, plain));
     /* The scene's plain run, written here with only gravity. */
     CHECK_OK(tc_case_from_dir(&ref, exe, "control-plain", tutorial));
-    char *ref_solver = with_forces(plain, "forces { gravity { g (0 -9.81 0); } }\n");
+    char *ref_solver = tc_with_forces(plain, "forces { gravity { g (0 -9.81 0); } }\n");
     CHECK_OK(tc_case_write(&ref, TC_SOLVER, ref_solver));
     /* The three forces with their regions above the tank (it is 0.6 m high). */
     CHECK_OK(tc_case_from_dir(&away, exe, "control-away", tutorial));
-    char *away_solver = with_forces(plain,
+    char *away_solver = tc_with_forces(plain,
                  "forces {\n gravity { g (0 -9.81 0); }\n"
                  " steer { type attraction; shape box; min (0.7 1.5 0); max (1.0 1.7 0);"
                  " attraction 150; influenceRadius 10; }\n"

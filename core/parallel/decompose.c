@@ -16,6 +16,7 @@
  */
 #include "parallel_internal.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <zoltan.h>
@@ -39,6 +40,21 @@ static double load_of(const mf_parallel *par, const mf_particles *p, const uint8
     return par->s.weight[k] + (walls && walls[i] ? par->s.weight_pressure_wall : 0.0);
 }
 
+/* Particle i's row in the pressure equation (the second criterion): fluid,
+ * inlet and outlet particles and the walls in the equation. */
+static double row_of(const mf_particles *p, const uint8_t *walls, size_t i)
+{
+    const int k = p->kind[i];
+    return k == MF_FLUID || k == MF_INLET || k == MF_OUTLET || (walls && walls[i]) ? 1.0 : 0.0;
+}
+
+/* The rows as a second criterion: with RCB only (Zoltan's HSFC balances
+ * one weight). */
+static bool two_criteria(const mf_parallel *par)
+{
+    return par->s.multi_criteria && par->s.method == MF_DECOMPOSE_RCB;
+}
+
 static int num_obj(void *data, int *ierr)
 {
     const mf_parallel *par = data;
@@ -59,7 +75,9 @@ static void obj_list(void *data, int ngid, int nlid, ZOLTAN_ID_PTR gids, ZOLTAN_
         gids[(size_t)ngid * i + 1] = (ZOLTAN_ID_TYPE)(id >> 32);
         lids[i] = (ZOLTAN_ID_TYPE)i;
         if (wdim > 0)
-            weights[i] = (float)load_of(par, p, par->zwalls, i);
+            weights[(size_t)wdim * i] = (float)load_of(par, p, par->zwalls, i);
+        if (wdim > 1)
+            weights[(size_t)wdim * i + 1] = (float)row_of(p, par->zwalls, i);
     }
     *ierr = ZOLTAN_OK;
 }
@@ -102,7 +120,17 @@ static int zoltan_setup(mf_parallel *par, int dim)
     Zoltan_Set_Param(zz, "LB_METHOD", method);
     Zoltan_Set_Param(zz, "NUM_GID_ENTRIES", "2");
     Zoltan_Set_Param(zz, "NUM_LID_ENTRIES", "1");
-    Zoltan_Set_Param(zz, "OBJ_WEIGHT_DIM", "1");
+    /* Two criteria: Zoltan's RCB then tries a cut along every axis and keeps
+     * the one whose worse criterion is best balanced (the max norm), where
+     * one criterion always cuts the longest axis. */
+    Zoltan_Set_Param(zz, "OBJ_WEIGHT_DIM", two_criteria(par) ? "2" : "1");
+    if (two_criteria(par))
+        Zoltan_Set_Param(zz, "RCB_MULTICRITERIA_NORM", "3");
+    /* Dots on a cut (a lattice plane) all go to one side, as
+     * Zoltan_LB_Point_Assign later puts them: the balance Zoltan computes
+     * for each axis is then the one the ranks get. */
+    if (par->s.method == MF_DECOMPOSE_RCB)
+        Zoltan_Set_Param(zz, "RCB_RECTILINEAR_BLOCKS", "1");
     Zoltan_Set_Param(zz, "RETURN_LISTS", "EXPORT");
     Zoltan_Set_Param(zz, "KEEP_CUTS", "1");      /* for Zoltan_LB_Point_Assign */
     Zoltan_Set_Param(zz, "IMBALANCE_TOL", "1.02");
@@ -299,14 +327,21 @@ double mf_parallel_imbalance(mf_parallel *par, const mf_particles *p, const uint
 {
     if (!par)
         return 1.0;
-    double load = 0;
-    for (size_t i = 0; i < p->n_owned; i++)
-        load += load_of(par, p, walls, i);
-    double total = load, heaviest = load;
-    mf_parallel_sum(par, &total, 1);
-    mf_parallel_max(par, &heaviest, 1);
-    const double mean = total / par->size;
-    par->stats.imbalance = mean > 0 ? heaviest / mean : 1.0;
+    double load[2] = {0, 0};
+    for (size_t i = 0; i < p->n_owned; i++) {
+        load[0] += load_of(par, p, walls, i);
+        load[1] += row_of(p, walls, i);
+    }
+    double total[2] = {load[0], load[1]}, heaviest[2] = {load[0], load[1]};
+    mf_parallel_sum(par, total, 2);
+    mf_parallel_max(par, heaviest, 2);
+    double ratio[2];
+    for (int c = 0; c < 2; c++) {
+        const double mean = total[c] / par->size;
+        ratio[c] = mean > 0 ? heaviest[c] / mean : 1.0;
+    }
+    par->stats.imbalance_rows = two_criteria(par) ? ratio[1] : 1.0;
+    par->stats.imbalance = fmax(ratio[0], par->stats.imbalance_rows);
     return par->stats.imbalance;
 }
 
@@ -327,11 +362,18 @@ int mf_parallel_rebalance(mf_parallel *par, mf_particles *p, bool force, const u
     if (p->n != p->n_owned)
         return MF_ERROR(MF_ERR_INTERNAL, "mf_parallel_rebalance: drop the halo first");
     const double imbalance = mf_parallel_imbalance(par, p, walls);
-    if (par->partitioned && !force && imbalance <= par->s.imbalance_threshold)
+    /* The threshold, or when the last partition could not get below it (a
+     * small scene's lattice planes, two criteria), the threshold's margin
+     * over what it achieved: otherwise every step would partition anew. */
+    const double limit = fmax(par->s.imbalance_threshold,
+                              par->s.imbalance_threshold * par->stats.imbalance_after);
+    if (par->partitioned && !force && imbalance <= limit)
         return 0;
     par->stats.imbalance_before = imbalance;
     MF_CALL(partition(par, p, walls));
-    mf_parallel_imbalance(par, p, NULL); /* the walls' marks moved with the particles */
+    /* The walls' marks moved with the particles: the caller may measure
+     * again with its new marks. */
+    par->stats.imbalance_after = mf_parallel_imbalance(par, p, NULL);
     return 0;
 }
 

@@ -49,6 +49,13 @@ typedef struct mf_parallel_settings {
     /* Added for a wall particle that is an unknown of the pressure equation
      * (walls beside the fluid; the others only count in neighbour lists). */
     double weight_pressure_wall;
+    /* Balance two criteria (Zoltan's multi-criteria RCB): the load above and
+     * the pressure equation's rows (fluid, inlet and outlet particles and
+     * the walls in the equation). The step is a sequence of phases each
+     * ended by a collective call, so its time is the sum over phases of the
+     * slowest rank: one total load balanced can leave every row of the
+     * solve on one rank. */
+    bool multi_criteria;
     /* false: mf_parallel_distribute leaves each rank its contiguous share of
      * the particles in the order they were built, and the first step makes
      * the first partition (a deliberately unbalanced start, for tests). */
@@ -63,8 +70,13 @@ typedef struct mf_parallel_stats {
     long migrations, rebalances;
     size_t migrated;        /* particles this rank sent away by migration (between partitions) */
     size_t repartitioned;   /* particles this rank sent away with new partitions */
-    double imbalance;       /* heaviest load / mean load at the last check */
+    double imbalance;       /* heaviest load / mean load at the last check (the larger
+                               of the two criteria's when multi_criteria) */
+    double imbalance_rows;  /* of the pressure rows alone (1 without multi_criteria) */
     double imbalance_before; /* the same before the last new partition */
+    double imbalance_after; /* right after it: what the partition could achieve (a
+                               caller that weighs by the pressure walls sets it
+                               with theirs) */
     double t_migrate, t_rebalance, t_halo; /* wall seconds */
     double t_halo_wait;     /* of t_halo: in the first collective call of a build,
                                where a rank waits for the slowest (load imbalance) */

@@ -22,6 +22,7 @@ void mf_parallel_default_settings(mf_parallel_settings *s)
     s->weight[MF_INLET] = 1.0;
     s->weight[MF_OUTLET] = 1.0;
     s->weight_pressure_wall = 0.33;
+    s->multi_criteria = true;
     s->first_partition = true;
 }
 

@@ -9,11 +9,13 @@
  *                              // step (a deliberately unbalanced start)
  *   imbalanceThreshold  1.1;   // a new partition when the heaviest rank carries
  *                              // more than this times the mean load
+ *   multiCriteria       yes;   // balance the pressure rows as well as the load
  *   weights { fluid 1; wall 0.35; dummy 0.2; inlet 1; outlet 1; }
  *
  * Every rank reads the case and builds the whole scene (or reads the whole
  * restart snapshot); mf_app_distribute then keeps each rank's share and the
  * first partition sends every particle to its subdomain. */
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
@@ -27,6 +29,7 @@ typedef struct decompose_settings {
     const char *method;
     const char *first_partition;
     double imbalance_threshold;
+    bool multi_criteria;
     const mf_dict *weights;
 } decompose_settings;
 
@@ -47,6 +50,10 @@ static const mf_param decompose_params[] = {
     {"imbalanceThreshold", MF_PARAM_SCALAR, "1.1", 1.0, 100, NULL,
      offsetof(decompose_settings, imbalance_threshold),
      "a new partition when the heaviest rank's load exceeds this times the mean"},
+    {"multiCriteria", MF_PARAM_BOOL, "yes", MF_NO_RANGE, NULL,
+     offsetof(decompose_settings, multi_criteria),
+     "balance the pressure equation's rows as well as the load (Zoltan's multi-criteria RCB "
+     "picks the cut axis); no: the load alone, cut across the longest axis"},
     {"weights", MF_PARAM_DICT, "{}", MF_NO_RANGE, NULL, offsetof(decompose_settings, weights),
      "load of a particle of each kind relative to a fluid particle"},
 };
@@ -122,6 +129,7 @@ int mf_app_create_parallel(mf_app *app, mf_dict *resolved)
         s.method = strcmp(ds.method, "HSFC") == 0 ? MF_DECOMPOSE_HSFC : MF_DECOMPOSE_RCB;
         s.imbalance_threshold = ds.imbalance_threshold;
         s.first_partition = strcmp(ds.first_partition, "none") != 0;
+        s.multi_criteria = ds.multi_criteria;
         memcpy(s.weight, ws.w, sizeof s.weight);
         rc = mf_parallel_create(&s, &app->sim.par);
     }
@@ -146,8 +154,10 @@ int mf_app_distribute(mf_app *app)
     mf_parallel_min(sim->par, &c[0], 1);
     mf_parallel_max(sim->par, &c[1], 1);
     mf_log_printf(sim->log, MF_LOG_NORMAL,
-                  "Decomposed: %.0f to %.0f particles a rank, load imbalance %.3f\n", c[0], c[1],
-                  mf_parallel_statistics(sim->par)->imbalance);
+                  "Decomposed: %.0f to %.0f particles a rank, load imbalance %.3f (pressure rows "
+                  "%.3f)\n",
+                  c[0], c[1], mf_parallel_statistics(sim->par)->imbalance,
+                  mf_parallel_statistics(sim->par)->imbalance_rows);
     return 0;
 }
 
@@ -181,10 +191,11 @@ void mf_app_report_parallel(const mf_app *app)
     if (mf_parallel_is_root(par)) {
         mf_log *log = (mf_log *)&app->log;
         mf_log_printf(log, MF_LOG_QUIET,
-                      "\nParallel: %d ranks, %ld new partitions, load imbalance %.3f at the end\n"
+                      "\nParallel: %d ranks, %ld new partitions, load imbalance %.3f at the end "
+                      "(pressure rows %.3f)\n"
                       "    rank   owned  halo/owned  halo kB/step  migrated/step  halo ms/step "
                       "(waiting)  migrate ms/step  rebalance s\n",
-                      size, st->rebalances, st->imbalance);
+                      size, st->rebalances, st->imbalance, st->imbalance_rows);
         for (int r = 0; r < size && size <= 16; r++) {
             const double *v = all + (size_t)r * NV;
             mf_log_printf(log, MF_LOG_QUIET,

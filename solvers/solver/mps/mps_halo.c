@@ -169,7 +169,7 @@ int mps_halo_begin(mps_data *d, mf_sim *sim, bool step_start)
     if (st->rebalances != before) { /* the flags moved with the particles */
         MF_CALL(mps_reserve(d, p->n));
         pressure_walls(d, p);
-        mf_parallel_imbalance(sim->par, p, d->dirichlet);
+        st->imbalance_after = mf_parallel_imbalance(sim->par, p, d->dirichlet);
         mf_log_printf(sim->log, MF_LOG_NORMAL, "Rebalanced: load imbalance %.3f, now %.3f\n",
                       st->imbalance_before, st->imbalance);
     }
