@@ -624,6 +624,55 @@ static void test_own_vcycle(void)
 }
 
 /* The fingerprint that decides reuse: blind to values, not to the pattern. */
+/* The split layout of rows in any column order, a diagonal given twice and
+ * a row longer than the one-pass stage: lower entries then upper ones, each
+ * in the row's order, the diagonal summed. */
+static void test_split_layout(void)
+{
+    enum { N = 400 };
+    size_t rowptr[N + 1];
+    int32_t *col = malloc(4 * N * N * sizeof *col);
+    double *val = malloc(4 * N * N * sizeof *val);
+    size_t k = 0;
+    unsigned long long seed = 7;
+    for (int i = 0; i < N; i++) {
+        rowptr[i] = k;
+        const int len = i == 17 ? N : 1 + (int)(i % 9); /* row 17: every column */
+        for (int e = 0; e < len; e++) {
+            seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+            col[k] = i == 17 ? (int32_t)((e * 7919) % N) : (int32_t)((seed >> 33) % N);
+            val[k++] = (double)(seed >> 40) / 16777216.0 + 0.5;
+        }
+        col[k] = i; /* a second diagonal entry */
+        val[k++] = 2.0;
+    }
+    rowptr[N] = k;
+    mf_csr A = {.nrows = N, .nglobal = N, .rowptr = rowptr, .col = col, .val = val};
+    mf_split_csr sp = {0};
+    CHECK_OK(mf_split_csr_set(&sp, &A));
+    size_t bad = 0;
+    for (int i = 0; i < N; i++) {
+        int32_t q = sp.ptr[i];
+        double d = 0.0;
+        for (size_t e = rowptr[i]; e < rowptr[i + 1]; e++) /* lower, in order */
+            if (col[e] < i)
+                bad += q >= sp.mid[i] || sp.col[q] != col[e] || sp.val[q++] != val[e];
+        bad += q != sp.mid[i];
+        for (size_t e = rowptr[i]; e < rowptr[i + 1]; e++) { /* upper, in order */
+            if (col[e] > i)
+                bad += q >= sp.ptr[i + 1] || sp.col[q] != col[e] || sp.val[q++] != val[e];
+            else if (col[e] == i)
+                d += val[e];
+        }
+        bad += q != sp.ptr[i + 1] || sp.diag[i] != d || sp.dinv[i] != 1.0 / d;
+    }
+    CHECK_MSG(bad == 0, "the split layout differs from the rows in %zu places", bad);
+    CHECK(sp.ptr[18] - sp.ptr[17] == N - 1); /* the long row: every column but its own */
+    mf_split_csr_free(&sp);
+    free(col);
+    free(val);
+}
+
 static void test_pattern_hash(void)
 {
     poisson p, q;
@@ -727,6 +776,7 @@ int main(int argc, char **argv)
     test_reuse();
     test_named_rows();
     test_own_vcycle();
+    test_split_layout();
     test_pattern_hash();
     test_bad_input();
 

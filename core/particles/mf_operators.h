@@ -62,6 +62,12 @@ void mf_laplacian(const mf_pairs *v, const mf_kernel *k, const double *f, int nc
 /* out += scale <lap f> (3 components): the viscous term nu <lap u> of eq. 9. */
 void mf_laplacian_add(const mf_pairs *v, const mf_kernel *k, const double *f, double scale,
                       const uint8_t *imask, const uint8_t *jmask, double *out);
+/* mf_number_density(v, imask, NULL, n) and, for the rows also in lmask,
+ * mf_laplacian_add(v, k, f, scale, lmask, NULL, out), in one pass over the
+ * pairs (the same sums, bit for bit); lmask within imask. */
+void mf_laplacian_add_number_density(const mf_pairs *v, const mf_kernel *k, const double *f,
+                                     double scale, const uint8_t *imask, const uint8_t *lmask,
+                                     double *out, double *n);
 /* eq. 27's viscous term with a pair viscosity: out_i += 2d/(lambda n0)
  * (1/rho_i) sum_j mu_ij (u_j - u_i) w_ij, mu_ij the pair average of mu
  * (mf_mu_pair) where j is in mu_mask, mu_i where it is not (3 components). */
@@ -90,6 +96,11 @@ void mf_number_density_rate(const mf_pairs *v, const double *u, const uint8_t *i
  * the fluid (free-surface detection by neighbour asymmetry). */
 void mf_neighbour_asymmetry(const mf_pairs *v, const mf_kernel *k, const uint8_t *imask,
                             const uint8_t *jmask, double *out);
+/* mf_number_density(v, imask, NULL, n) and, for the rows also in amask,
+ * mf_neighbour_asymmetry(v, k, amask, NULL, asym), in one pass over the
+ * pairs (the same sums, bit for bit); amask within imask. */
+void mf_number_density_asymmetry(const mf_pairs *v, const mf_kernel *k, const uint8_t *imask,
+                                 const uint8_t *amask, double *n, double *asym);
 /* (d/n0) sum_j r_ij w_ij/|r_ij|^2 (3 per particle): the gradient of the
  * particle concentration in MPS form (eq. 5 on C = 1 without the f_i term),
  * pointing to where neighbours crowd (particle shifting). */

@@ -69,6 +69,9 @@ typedef struct mf_particles {
 int mf_particles_create(int dim, size_t cap, mf_particles **out);
 void mf_particles_destroy(mf_particles *p);
 int mf_particles_reserve(mf_particles *p, size_t cap);
+/* Shrink the arrays to p->n + headroom particles (a built scene: what
+ * mf_particles_add's doubling left unused). */
+int mf_particles_fit(mf_particles *p, size_t headroom);
 
 /* Append one owned particle; a fresh unique id is assigned and returned in
  * *id_out (may be NULL). Optional fields of the new particle are zero. */

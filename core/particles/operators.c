@@ -448,6 +448,56 @@ void mf_laplacian_add(const mf_pairs *v, const mf_kernel *k, const double *f, do
     mf_pairs_each(v, imask, lap3_add_row, &c);
 }
 
+/* The number density and, in the same pass over each row, the viscous
+ * term: each sum gets the pairs in the order the two operators alone give
+ * them (a pair of zero weight adds nothing to either), so the results are
+ * theirs bit for bit. */
+typedef struct {
+    lap_ctx lap;              /* mf_laplacian_add's (jmask NULL) */
+    const uint8_t *lmask;     /* rows that also want the Laplacian */
+    double *n;
+} lap_nd_ctx;
+
+typedef struct {
+    double a[3];
+    double n;
+} lap_nd_acc;
+
+static inline bool lap3_nd_pair(void *acc, const void *ctx, const mf_pair *pr)
+{
+    const lap_nd_ctx *c = ctx;
+    lap_nd_acc *s = acc;
+    s->n += mf_weight(pr->len, c->lap.v->radius);
+    return lap3_pair(s->a, &c->lap, pr);
+}
+
+static void lap3_add_nd_row(const void *ctx, size_t i)
+{
+    const lap_nd_ctx *c = ctx;
+    if (!c->lmask[i]) {
+        const nd_ctx nd = {c->lap.v, NULL, c->n};
+        nd_row(&nd, i);
+        return;
+    }
+    lap_nd_acc s = {{0.0, 0.0, 0.0}, 0.0};
+    mf_pairs_row(c->lap.v, i, NULL, lap3_nd_pair, c, &s);
+    c->n[i] = s.n;
+    for (int q = 0; q < 3; q++) {
+        const double lap = c->lap.coef * s.a[q];
+        c->lap.out[3 * i + q] += c->lap.scale * lap;
+    }
+}
+
+void mf_laplacian_add_number_density(const mf_pairs *v, const mf_kernel *k, const double *f,
+                                     double scale, const uint8_t *imask, const uint8_t *lmask,
+                                     double *out, double *n)
+{
+    const lap_nd_ctx c = {{.v = v, .jmask = NULL, .f = f, .ncomp = 3, .coef = lap_coef(k),
+                           .scale = scale, .out = out},
+                          lmask, n};
+    mf_pairs_each(v, imask, lap3_add_nd_row, &c);
+}
+
 void mf_laplacian_mu(const mf_pairs *v, const mf_kernel *k, const double *f, const double *mu,
                      int mu_average, const uint8_t *mu_mask, const double *rho,
                      const uint8_t *imask, double *out)
@@ -585,6 +635,50 @@ void mf_neighbour_asymmetry(const mf_pairs *v, const mf_kernel *k, const uint8_t
 {
     const dir_ctx c = {v, jmask, 1.0 / k->n0, out};
     mf_pairs_each(v, imask, unit_row, &c);
+}
+
+/* The number density and, in the same pass over each row, the asymmetry:
+ * each sum gets the pairs in the order the two operators alone give them,
+ * so the results are theirs bit for bit. */
+typedef struct {
+    dir_ctx dir;              /* the asymmetry's (jmask NULL) */
+    const uint8_t *amask;     /* rows that also want the asymmetry */
+    double *n;
+} nd_asym_ctx;
+
+typedef struct {
+    double n;
+    double a[3];
+} nd_asym_acc;
+
+static inline bool nd_asym_pair(void *acc, const void *ctx, const mf_pair *pr)
+{
+    const nd_asym_ctx *c = ctx;
+    nd_asym_acc *s = acc;
+    s->n += mf_weight(pr->len, c->dir.v->radius);
+    return unit_pair(s->a, &c->dir, pr);
+}
+
+static void nd_asym_row(const void *ctx, size_t i)
+{
+    const nd_asym_ctx *c = ctx;
+    if (!c->amask[i]) {
+        const nd_ctx nd = {c->dir.v, NULL, c->n};
+        nd_row(&nd, i);
+        return;
+    }
+    nd_asym_acc s = {0.0, {0.0, 0.0, 0.0}};
+    mf_pairs_row(c->dir.v, i, NULL, nd_asym_pair, c, &s);
+    c->n[i] = s.n;
+    for (int q = 0; q < 3; q++)
+        c->dir.out[3 * i + q] = c->dir.coef * s.a[q];
+}
+
+void mf_number_density_asymmetry(const mf_pairs *v, const mf_kernel *k, const uint8_t *imask,
+                                 const uint8_t *amask, double *n, double *asym)
+{
+    const nd_asym_ctx c = {{v, NULL, 1.0 / k->n0, asym}, amask, n};
+    mf_pairs_each(v, imask, nd_asym_row, &c);
 }
 
 void mf_concentration_gradient(const mf_pairs *v, const mf_kernel *k, const uint8_t *imask,

@@ -142,6 +142,30 @@ int mf_particles_reserve(mf_particles *p, size_t cap)
     return 0;
 }
 
+/* Shrink every array to the particles held plus headroom (never below
+ * them): the doubling of mf_particles_add leaves up to half of each array
+ * unused once a scene is built. A realloc to a smaller size keeps the
+ * contents; should one fail, that array keeps its larger block. */
+int mf_particles_fit(mf_particles *p, size_t headroom)
+{
+    if (!p)
+        return MF_ERROR(MF_ERR_INPUT, "mf_particles_fit: p is NULL");
+    size_t cap = p->n + headroom;
+    if (cap < MIN_CAPACITY)
+        cap = MIN_CAPACITY;
+    if (cap >= p->cap)
+        return 0;
+    array_ref refs[MAX_ARRAYS];
+    int narrays = list_arrays(p, refs);
+    for (int a = 0; a < narrays; a++) {
+        void *q = realloc(*refs[a].data, cap * refs[a].elem_size);
+        if (q) /* on failure the array keeps its larger block: still >= cap */
+            *refs[a].data = q;
+    }
+    p->cap = cap;
+    return 0;
+}
+
 /* ---- add / remove / permute -------------------------------------------- */
 
 int mf_particles_add(mf_particles *p, int kind, const double x[3], const double v[3],

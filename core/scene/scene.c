@@ -560,6 +560,8 @@ static int build_scene(const mf_dict *geometry, double l0_override, mf_sim *sim,
                                resolved && g.emitters ? mf_dict_set_subdict(resolved, "emitters")
                                                       : NULL,
                                &sim->emitters));
+    /* The store as built, with 1/16 headroom (mf_particles_add doubles). */
+    MF_CALL(mf_particles_fit(sim->p, sim->p->n / 16 + 64));
     return 0;
 }
 

@@ -114,7 +114,7 @@ typedef struct mps_data {
     double *n_start;   /* n at r^n (mixed, errorCompensating) */
     double *rate_start; /* Dn/Dt at r^n, u^n (errorCompensating) */
     double *src;       /* the PPE source / rho of the unknowns (NULL: eq. 14 as printed) */
-    double *work;      /* 15n: scratch (divergence, minimum, asymmetry, shifting) */
+    double *work;      /* 3n, 15n with shifting: scratch (divergence, minimum, asymmetry, shifting) */
     uint8_t *flag_work; /* n: scratch (LSMPS fallbacks, the surface band) */
     size_t cap_scheme;
     double density_scale;      /* the density terms' factor this step (retries, mps_source.c) */

@@ -109,7 +109,7 @@ int mps_reserve(mps_data *d, size_t n)
 {
     if (n <= d->cap)
         return 0;
-    size_t cap = n + n / 4 + 64;
+    size_t cap = n + n / 16 + 64;
     if (mf_resize(&d->acc, 3 * cap, sizeof *d->acc) ||
         mf_resize(&d->grad, 3 * cap, sizeof *d->grad) ||
         mf_resize(&d->is_fluid, cap, 1) || mf_resize(&d->in_ppe, cap, 1) ||

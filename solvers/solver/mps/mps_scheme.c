@@ -121,7 +121,7 @@ int mps_scheme_reserve(mps_data *d, size_t n)
     if (n <= d->cap_scheme)
         return 0;
     const mps_scheme *sc = &d->sc;
-    const size_t cap = n + n / 4 + 64;
+    const size_t cap = n + n / 16 + 64;
     const bool start = sc->source == MPS_SOURCE_MIXED ||
                        sc->source == MPS_SOURCE_ERROR_COMPENSATING;
     int rc = 0;
@@ -131,7 +131,10 @@ int mps_scheme_reserve(mps_data *d, size_t n)
         rc |= grow((void **)&d->rate_start, cap, sizeof *d->rate_start);
     if (sc->source != MPS_SOURCE_DENSITY)
         rc |= grow((void **)&d->src, cap, sizeof *d->src);
-    rc |= grow((void **)&d->work, 15 * cap, sizeof *d->work);
+    /* 3n for a vector (the surface's asymmetry); shifting adds a normal and
+     * a velocity gradient (3 + 3 + 9, mps_shift.c). */
+    const size_t width = sc->shifting == MPS_SHIFT_NONE ? 3 : 15;
+    rc |= grow((void **)&d->work, width * cap, sizeof *d->work);
     rc |= grow((void **)&d->flag_work, cap, sizeof *d->flag_work);
     if (rc)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory for the scheme's arrays (%zu particles)",

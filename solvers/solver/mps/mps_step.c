@@ -137,9 +137,18 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
     mf_particles *p = sim->p;
     const double nu = sim->fluid[0].nu;
     retry_scale(d, sim, dt);
+    /* The mixed source's n at r^n rides in the viscous term's pass when both
+     * are eq. 3's sums over the same pairs (the same values, one pass); not
+     * with wall weight, whose share is added to n at r^n (mps_wall.c). */
+    const bool nd_with_viscosity = !d->visc && !d->mu && !d->wall && nu > 0 &&
+                                   d->sc.laplacian == MPS_LAPLACIAN_PAPER &&
+                                   d->sc.source == MPS_SOURCE_MIXED && d->k_nd.re == d->k_lap.re;
     if (d->wall) /* wall weight: the walls' sums at r^n */
         MF_CALL(mps_wall_points(d, sim));
-    MF_CALL(mps_source_start(d, sim)); /* what the scheme's source needs of r^n, u^n */
+    if (nd_with_viscosity)
+        MF_CALL(mps_scheme_reserve(d, p->n));
+    else
+        MF_CALL(mps_source_start(d, sim)); /* what the scheme's source needs of r^n, u^n */
     mps_bodies_begin(d, sim);
     memset(d->acc, 0, 3 * p->n * sizeof *d->acc);
     MF_CALL(mf_force_accumulate(sim, d->acc));
@@ -155,6 +164,9 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
         if (d->mu) /* eq. 27: each pair through mu_ij, walls and dummies with mu_i */
             mf_laplacian_mu(&v, &d->k_lap, p->vel, d->mu, d->mu_average, d->is_fluid, d->rho,
                             d->is_fluid, d->acc);
+        else if (nd_with_viscosity)
+            mf_laplacian_add_number_density(&v, &d->k_lap, p->vel, nu, d->not_dummy, d->is_fluid,
+                                            d->acc, d->n_start);
         else
             mf_laplacian_add(&v, &d->k_lap, p->vel, nu, d->is_fluid, NULL, d->acc);
     }
@@ -194,13 +206,11 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
  * surface (p = 0); its source is clipped at zero (mps_ppe.c): a wall pushes
  * and does not pull. Into d->flag_work: 1 on the surface. */
 #define MPS_SPARSE 0.8
-static int detect_by_asymmetry(mps_data *d, mf_sim *sim, const mf_pairs *vnd)
+static int detect_by_asymmetry(mps_data *d, mf_sim *sim)
 {
     mf_particles *p = sim->p;
-    MF_CALL(mps_scheme_reserve(d, p->n));
     const double *n = mf_particles_fd(p, d->f_number_density);
-    double *F = d->work;
-    mf_neighbour_asymmetry(vnd, &d->k_nd, d->is_fluid, NULL, F);
+    const double *F = d->work; /* the asymmetry of the fluid (mps_surface_phase) */
     mf_pairs vg;
     MF_CALL(mps_pairs(d, sim, d->h_grad, &vg));
     const double thr = d->s.asymmetry * d->k_nd.asym_flat, n0 = d->k_nd.n0;
@@ -231,14 +241,22 @@ int mps_surface_phase(mps_data *d, mf_sim *sim)
     int32_t *flags = mf_particles_fi(p, d->f_flags);
     mf_pairs v;
     MF_CALL(mps_pairs(d, sim, d->h_nd, &v));
-    mf_number_density(&v, d->not_dummy, NULL, n);
+    const double n0 = d->k_nd.n0;
+    const bool asymmetry = d->sc.detection == MPS_DETECT_ASYMMETRY;
+    if (asymmetry)
+        MF_CALL(mps_scheme_reserve(d, p->n));
+    if (asymmetry && !d->wall) /* n* of the particles and the fluid's asymmetry in one pass */
+        mf_number_density_asymmetry(&v, &d->k_nd, d->not_dummy, d->is_fluid, n, d->work);
+    else
+        mf_number_density(&v, d->not_dummy, NULL, n);
     if (d->wall) { /* the walls' sums at r*, their number density */
         MF_CALL(mps_wall_points(d, sim));
         mps_wall_number_density(d, sim, n);
+        if (asymmetry) /* after the walls' sums, which may use the scratch */
+            mf_neighbour_asymmetry(&v, &d->k_nd, d->is_fluid, NULL, d->work);
     }
-    const double n0 = d->k_nd.n0;
-    if (d->sc.detection == MPS_DETECT_ASYMMETRY)
-        MF_CALL(detect_by_asymmetry(d, sim, &v));
+    if (asymmetry)
+        MF_CALL(detect_by_asymmetry(d, sim));
     for (size_t i = 0; i < p->n_owned; i++) {
         bool surface = d->sc.detection == MPS_DETECT_ASYMMETRY
                            ? d->flag_work[i]
