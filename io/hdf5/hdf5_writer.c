@@ -46,15 +46,25 @@ typedef struct snap_writer {
     void *buf;          /* gather buffer: count * max components * 8 bytes */
 } snap_writer;
 
+/* Create group name in parent; on failure an MF_ERR_IO naming what (the
+ * group's file:/path) and HDF5's reason, and *g < 0. */
+static int create_group(hid_t parent, const char *name, const char *what, hid_t *g)
+{
+    char detail[256];
+    *g = H5Gcreate2(parent, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    if (*g < 0)
+        return MF_ERROR(MF_ERR_IO, "%s: cannot create the group (%s)", what,
+                        mf_h5_error_detail(detail, sizeof detail));
+    return 0;
+}
+
 static int write_header(const snap_writer *w, const mf_sim *sim,
                         const int64_t counts[MF_NKINDS])
 {
-    char what[MF_H5_PATH_MAX], detail[256];
+    char what[MF_H5_PATH_MAX];
     snprintf(what, sizeof what, "%s:/Header", w->path);
-    hid_t g = H5Gcreate2(w->file, "Header", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-    if (g < 0)
-        return MF_ERROR(MF_ERR_IO, "%s: cannot create the group (%s)", what,
-                        mf_h5_error_detail(detail, sizeof detail));
+    hid_t g;
+    MF_CALL(create_group(w->file, "Header", what, &g));
     int64_t step = sim->step, next_id = w->p->next_id;
     mf_parallel_max_i64(w->par, &next_id, 1); /* the smallest id no rank has used */
     const int dim = w->p->dim, one = 1;
@@ -82,12 +92,10 @@ done:
 
 static int write_parameters(const snap_writer *w, const mf_dict *params)
 {
-    char what[MF_H5_PATH_MAX], detail[256];
+    char what[MF_H5_PATH_MAX];
     snprintf(what, sizeof what, "%s:/Parameters", w->path);
-    hid_t g = H5Gcreate2(w->file, "Parameters", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-    if (g < 0)
-        return MF_ERROR(MF_ERR_IO, "%s: cannot create the group (%s)", what,
-                        mf_h5_error_detail(detail, sizeof detail));
+    hid_t g;
+    MF_CALL(create_group(w->file, "Parameters", what, &g));
     int rc = mf_h5_write_dict(g, params, what);
     H5Gclose(g);
     MF_CALL(rc);
@@ -192,7 +200,7 @@ static void gather_int32(const snap_writer *w, const int32_t *src, int ncomp)
 
 static int write_kind(snap_writer *w, int kind)
 {
-    char group_name[32], what[MF_H5_PATH_MAX], detail[256];
+    char group_name[32], what[MF_H5_PATH_MAX];
     const mf_particles *p = w->p;
     mf_h5_part_group(kind, group_name, sizeof group_name);
     snprintf(what, sizeof what, "%s:/%s", w->path, group_name);
@@ -203,10 +211,8 @@ static int write_kind(snap_writer *w, int kind)
             w->index[w->count++] = i;
     w->first = (hsize_t)mf_parallel_exscan(w->par, (int64_t)w->count);
 
-    hid_t g = H5Gcreate2(w->file, group_name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-    if (g < 0)
-        return MF_ERROR(MF_ERR_IO, "%s: cannot create the group (%s)", what,
-                        mf_h5_error_detail(detail, sizeof detail));
+    hid_t g;
+    MF_CALL(create_group(w->file, group_name, what, &g));
     int rc = 0;
     MF_CALL_GOTO(rc, mf_h5_attr_write_string(g, "KindName", mf_h5_kind_name(kind), what), done);
 
@@ -312,12 +318,10 @@ static int write_bodies(const snap_writer *w, const mf_sim *sim)
     const mf_walls *ws = sim->walls;
     if (mf_bodies_count(ws) == 0)
         return 0;
-    char what[MF_H5_PATH_MAX], detail[256];
+    char what[MF_H5_PATH_MAX];
     snprintf(what, sizeof what, "%s:/RigidBodies", w->path);
-    hid_t g = H5Gcreate2(w->file, "RigidBodies", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-    if (g < 0)
-        return MF_ERROR(MF_ERR_IO, "%s: cannot create the group (%s)", what,
-                        mf_h5_error_detail(detail, sizeof detail));
+    hid_t g;
+    MF_CALL(create_group(w->file, "RigidBodies", what, &g));
     int rc = 0;
     for (size_t k = 0; rc == 0 && k < ws->n; k++) {
         if (!ws->w[k].body)
@@ -325,12 +329,9 @@ static int write_bodies(const snap_writer *w, const mf_sim *sim)
         mf_body_momentum b;
         mf_body_get(&ws->w[k], &b);
         snprintf(what, sizeof what, "%s:/RigidBodies/%s", w->path, ws->w[k].name);
-        hid_t gb = H5Gcreate2(g, ws->w[k].name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-        if (gb < 0) {
-            rc = MF_ERROR(MF_ERR_IO, "%s: cannot create the group (%s)", what,
-                          mf_h5_error_detail(detail, sizeof detail));
+        hid_t gb;
+        if ((rc = create_group(g, ws->w[k].name, what, &gb)) != 0)
             break;
-        }
         const struct {
             const char *name;
             const double *v;
