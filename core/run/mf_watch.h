@@ -39,6 +39,7 @@
 #include <stdbool.h>
 
 #include "mf_dict.h"
+#include "mf_log.h"
 #include "mf_params.h"
 #include "mf_sim.h"
 
@@ -76,6 +77,9 @@ int mf_watch_init(mf_watch *w, const mf_dict *dict, mf_dict *resolved);
 int mf_watch_check(mf_watch *w, const mf_sim *sim, double dt);
 /* The step was accepted: keep its energy bookkeeping. */
 void mf_watch_accept(mf_watch *w);
+/* The end of a run: how close it came to the energy criterion (the log's
+ * `Watch:` line; nothing when the energy check is off). */
+void mf_watch_report(const mf_watch *w, mf_log *log);
 
 #pragma GCC visibility pop
 #endif

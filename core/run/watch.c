@@ -319,3 +319,12 @@ void mf_watch_accept(mf_watch *w)
         w->peak_excess_time = w->next_time;
     }
 }
+
+void mf_watch_report(const mf_watch *w, mf_log *log)
+{
+    if (w->s.enabled && w->started && isfinite(w->s.energy_tolerance))
+        mf_log_printf(log, MF_LOG_QUIET,
+                      "Watch: kinetic energy above its start and the forces' work by at most "
+                      "%.3g of the energy scale (t = %g; energyTolerance %g)\n",
+                      w->peak_excess, w->peak_excess_time, w->s.energy_tolerance);
+}

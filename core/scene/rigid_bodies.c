@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "mf_error.h"
+#include "mf_mat3.h"
 #include "mf_fs.h"
 
 typedef struct mf_body {
@@ -29,32 +30,6 @@ typedef struct mf_body {
     double face_area[6], round_area;
     FILE *csv;
 } mf_body;
-
-static void mat_vec(const double M[9], const double x[3], double y[3])
-{
-    for (int a = 0; a < 3; a++)
-        y[a] = M[3 * a] * x[0] + M[3 * a + 1] * x[1] + M[3 * a + 2] * x[2];
-}
-
-static void mat_t_vec(const double M[9], const double x[3], double y[3])
-{
-    for (int a = 0; a < 3; a++)
-        y[a] = M[a] * x[0] + M[3 + a] * x[1] + M[6 + a] * x[2];
-}
-
-static void mat_mul(const double A[9], const double B[9], double C[9])
-{
-    for (int r = 0; r < 3; r++)
-        for (int c = 0; c < 3; c++)
-            C[3 * r + c] = A[3 * r] * B[c] + A[3 * r + 1] * B[3 + c] + A[3 * r + 2] * B[6 + c];
-}
-
-static void cross(const double a[3], const double b[3], double c[3])
-{
-    c[0] = a[1] * b[2] - a[2] * b[1];
-    c[1] = a[2] * b[0] - a[0] * b[2];
-    c[2] = a[0] * b[1] - a[1] * b[0];
-}
 
 /* Inverse of a symmetric positive definite 3x3 matrix (the adjugate). */
 static bool invert3(const double A[9], double B[9])
@@ -175,7 +150,7 @@ int mf_body_create(mf_wall *w, int dim)
     b->R[0] = b->R[4] = b->R[8] = 1;
     for (int a = 0; a < 3; a++)
         b->w[a] = m->omega * m->axis[a];
-    mat_vec(b->Ib, b->w, b->L); /* R = I at t = 0 */
+    mf_mat3_vec(b->Ib, b->w, b->L); /* R = I at t = 0 */
     memcpy(b->xt, b->x, sizeof b->x);
     memcpy(b->vt, b->v, sizeof b->v);
     memcpy(b->Rt, b->R, sizeof b->R);
@@ -250,16 +225,16 @@ void mf_bodies_set_trial(mf_walls *ws, double dt)
         if (dim == 2)
             b->Lt[0] = b->Lt[1] = 0;
         /* w = R I_b^-1 R^T L with the orientation at t^n */
-        mat_t_vec(b->R, b->Lt, Linv);
-        mat_vec(b->Ib_inv, Linv, wb);
-        mat_vec(b->R, wb, b->wt);
+        mf_mat3_t_vec(b->R, b->Lt, Linv);
+        mf_mat3_vec(b->Ib_inv, Linv, wb);
+        mf_mat3_vec(b->R, wb, b->wt);
         const double speed = sqrt(b->wt[0] * b->wt[0] + b->wt[1] * b->wt[1] +
                                   b->wt[2] * b->wt[2]);
         if (speed > 0) {
             const double axis[3] = {b->wt[0] / speed, b->wt[1] / speed, b->wt[2] / speed};
             double dR[9];
             mf_rotation_matrix(axis, speed * dt, dR);
-            mat_mul(dR, b->R, b->Rt);
+            mf_mat3_mul(dR, b->R, b->Rt);
         } else {
             memcpy(b->Rt, b->R, sizeof b->R);
         }
@@ -285,7 +260,7 @@ void mf_body_add_force(mf_wall *w, const double x[3], const double f[3])
     const double *c = w->body->xt; /* the centre where the step has it */
     const double r[3] = {x[0] - c[0], x[1] - c[1], x[2] - c[2]};
     double t[3];
-    cross(r, f, t);
+    mf_cross3(r, f, t);
     for (int a = 0; a < 3; a++) {
         w->force[a] += f[a];
         w->torque[a] += t[a];
@@ -486,7 +461,7 @@ int mf_body_surface(const mf_wall *w, const double x[3], double l0, double out_a
             memset(nb, 0, sizeof nb);
             nb[f / 2] = f % 2 ? 1 : -1;
             db = depth[f];
-            mat_vec(w->state.R, nb, out_area[n]);
+            mf_mat3_vec(w->state.R, nb, out_area[n]);
             for (int a = 0; a < 3; a++) {
                 out_shift[n][a] = db * out_area[n][a];
                 out_area[n][a] *= b->face_area[f];
@@ -503,7 +478,7 @@ int mf_body_surface(const mf_wall *w, const double x[3], double l0, double out_a
         return 0;
     for (int a = 0; a < dim; a++)
         nb[a] = (xb[a] - w->centre[a]) / r;
-    mat_vec(w->state.R, nb, out_area[0]);
+    mf_mat3_vec(w->state.R, nb, out_area[0]);
     for (int a = 0; a < 3; a++) {
         out_shift[0][a] = (w->radius - r) * out_area[0][a];
         out_area[0][a] *= b->round_area;

@@ -9,6 +9,7 @@
 
 #include "mf_bodies.h"
 #include "mf_error.h"
+#include "mf_mat3.h"
 #include "walls_internal.h"
 
 int mf_walls_create(int dim, double l0, bool particles, mf_walls **out)
@@ -203,19 +204,13 @@ double mf_wall_body_distance(const mf_wall *w, const double xb[3], double n[3])
     return INFINITY;
 }
 
-static void rotate(const double R[9], const double v[3], double out[3])
-{
-    for (int a = 0; a < 3; a++)
-        out[a] = R[3 * a] * v[0] + R[3 * a + 1] * v[1] + R[3 * a + 2] * v[2];
-}
-
 double mf_wall_distance(const mf_wall *w, const double x[3], double n[3])
 {
     double xb[3], nb[3];
     mf_wall_to_body(w, x, xb);
     const double d = mf_wall_body_distance(w, xb, nb);
     if (n)
-        rotate(w->state.R, nb, n);
+        mf_mat3_vec(w->state.R, nb, n);
     return d;
 }
 

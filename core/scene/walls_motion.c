@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "mf_error.h"
+#include "mf_mat3.h"
 #include "mf_params.h"
 #include "mf_walls.h"
 
@@ -407,20 +408,13 @@ void mf_wall_to_world(const mf_wall *w, const double xb[3], double x[3])
         x[a] = o[a] + d[a] + R[3 * a] * r[0] + R[3 * a + 1] * r[1] + R[3 * a + 2] * r[2];
 }
 
-static void cross(const double a[3], const double b[3], double c[3])
-{
-    c[0] = a[1] * b[2] - a[2] * b[1];
-    c[1] = a[2] * b[0] - a[0] * b[2];
-    c[2] = a[0] * b[1] - a[1] * b[0];
-}
-
 void mf_wall_velocity(const mf_wall *w, const double x[3], bool with_surface, double v[3])
 {
     const mf_rigid_state *s = &w->state;
     double r[3], wr[3];
     for (int a = 0; a < 3; a++)
         r[a] = x[a] - w->motion.origin[a] - s->d[a];
-    cross(s->w, r, wr);
+    mf_cross3(s->w, r, wr);
     for (int a = 0; a < 3; a++)
         v[a] = s->v[a] + wr[a];
     if (with_surface) {
@@ -436,9 +430,9 @@ void mf_wall_acceleration(const mf_wall *w, const double x[3], double acc[3])
     double r[3], ar[3], wr[3], wwr[3];
     for (int a = 0; a < 3; a++)
         r[a] = x[a] - w->motion.origin[a] - s->d[a];
-    cross(s->dw, r, ar);
-    cross(s->w, r, wr);
-    cross(s->w, wr, wwr);
+    mf_cross3(s->dw, r, ar);
+    mf_cross3(s->w, r, wr);
+    mf_cross3(s->w, wr, wwr);
     for (int a = 0; a < 3; a++)
         acc[a] = s->a[a] + ar[a] + wwr[a];
 }

@@ -269,12 +269,7 @@ static int run_case(mf_app *app)
         mf_log_printf(&app->log, MF_LOG_QUIET, "Force %s: %ld calls, %.3f s\n",
                       app->sim.forces[k].info->name, app->sim.forces[k].calls,
                       app->sim.forces[k].seconds);
-    const mf_watch *watch = &app->run.watch;
-    if (watch->s.enabled && watch->started && isfinite(watch->s.energy_tolerance))
-        mf_log_printf(&app->log, MF_LOG_QUIET,
-                      "Watch: kinetic energy above its start and the forces' work by at most "
-                      "%.3g of the energy scale (t = %g; energyTolerance %g)\n",
-                      watch->peak_excess, watch->peak_excess_time, watch->s.energy_tolerance);
+    mf_watch_report(&app->run.watch, &app->log);
     mf_log_printf(&app->log, MF_LOG_QUIET,
                   "\nSteps %ld (retried %ld), snapshots %d, wall time %.2f s, peak memory %.1f "
                   "MB\n",

@@ -23,6 +23,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_alloc.h"
 #include "mf_error.h"
 #include "mf_hdf5.h"
 #include "mf_post.h"
@@ -72,19 +73,12 @@ static int read_track(const char *path, double **t, double **x, double **y, size
         if (line[0] == '#' || sscanf(line, "%lf,%lf,%lf", &a, &b, &c) != 3)
             continue;
         if (*n == cap) {
-            cap = cap ? 2 * cap : 1024;
-            double *nt = realloc(*t, cap * sizeof *nt), *nx = nt ? realloc(*x, cap * sizeof *nx) : NULL,
-                   *ny = nx ? realloc(*y, cap * sizeof *ny) : NULL;
-            if (nt)
-                *t = nt;
-            if (nx)
-                *x = nx;
-            if (ny)
-                *y = ny;
-            if (!ny) {
-                rc = MF_ERROR(MF_ERR_MEMORY, "out of memory");
+            const size_t grown = cap ? 2 * cap : 1024;
+            if ((rc = mf_resize(t, grown, sizeof **t)) != 0 ||
+                (rc = mf_resize(x, grown, sizeof **x)) != 0 ||
+                (rc = mf_resize(y, grown, sizeof **y)) != 0)
                 break;
-            }
+            cap = grown;
         }
         (*t)[*n] = a;
         (*x)[*n] = b;
