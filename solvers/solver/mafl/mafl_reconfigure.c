@@ -275,10 +275,17 @@ int mafl_reconfigure(mafl_data *d, mf_sim *sim, double dt)
                 break;
             }
         }
-        for (int c = 0; c < 3; c++) {
-            uc[3 * i + c] = (out[c] - a[c]) / dt; /* eq. 19 */
-            ua[3 * i + c] = (b[c] - out[c]) / dt; /* eq. 20 */
-        }
     }
+    /* Moving points: pairs that came too close move apart rather than
+     * merge (mafl_separation.c). */
+    d->last_separated = 0;
+    if ((d->rule == MAFL_RULE_FRACTION || d->rule == MAFL_RULE_RELAX) && d->s.separation > 0)
+        MF_CALL(mafl_separate(d, sim, d->shift));
+#pragma omp parallel for schedule(static)
+    for (long i = 0; i < n; i++)
+        for (int c = 0; c < 3; c++) {
+            uc[3 * i + c] = (xnew[3 * i + c] - xn[3 * i + c]) / dt; /* eq. 19 */
+            ua[3 * i + c] = (xl[3 * i + c] - xnew[3 * i + c]) / dt; /* eq. 20 */
+        }
     return 0;
 }
