@@ -70,6 +70,7 @@ typedef struct mafl_settings {
     double hole_distance;      /* a lattice site with no point this close (in l0) ... */
     double hole_density;       /* ... and number density >= this n0 is a hole */
     bool hole_spacing;         /* a new point goes l0 from its nearest point */
+    double separation;         /* rules fraction, relax: points closer than this (l0) move apart */
 } mafl_settings;
 
 #define MAFL_MAX_CARRIED (3 + MF_MAX_SCALARS)
@@ -103,8 +104,10 @@ typedef struct mafl_data {
     double *value;             /* MAFL_MAX_CARRIED * n: new values, field-major */
     uint8_t *convected;        /* 1 if the Eulerian phase set the point's values */
     uint8_t *remove;           /* points merged away */
+    double *shift;             /* 3n: the separation's shifts (mafl_separation.c) */
     /* Statistics. */
     size_t last_added, last_removed, total_added, total_removed;
+    size_t last_separated, total_separated; /* points moved apart (mafl_separation.c) */
     double q_max;              /* largest q of the last step */
     long q_limited;            /* grid points where |u^a| dt > dr widened the grid */
     double t_lagrangian, t_reconfigure, t_eulerian, t_points;
@@ -114,7 +117,7 @@ typedef struct mafl_data {
 } mafl_data;
 
 extern const mf_solver_ops mf_solver_MAFL;
-#define MAFL_NPARAMS (MPS_NPARAMS + 14)
+#define MAFL_NPARAMS (MPS_NPARAMS + 15)
 extern const mf_param mafl_params[MAFL_NPARAMS];
 
 /* mafl_module.c */
@@ -134,6 +137,10 @@ int mafl_lagrangian(mafl_data *d, mf_sim *sim, double dt);
 /* mafl_reconfigure.c: r^{n+1} into d->pos_new (eqs. 19-20 into the
  * PointVelocity and ConvectionVelocity fields). Needs d->grid at r^L. */
 int mafl_reconfigure(mafl_data *d, mf_sim *sim, double dt);
+
+/* mafl_separation.c: fluid points closer than separation l0 at r^{n+1}
+ * (d->pos_new) move apart, shift: 3n of work. Needs d->grid at r^L. */
+int mafl_separate(mafl_data *d, mf_sim *sim, double *shift);
 
 /* mafl_eulerian.c: new values of the carried fields into d->value
  * (eqs. 21, 23-26). Needs d->grid at r^L. */

@@ -17,13 +17,16 @@ int mafl_reserve(mafl_data *d, size_t n)
     free(d->convected);
     free(d->remove);
     free(d->n_offset);
+    free(d->shift);
+    d->shift = malloc(3 * cap * sizeof *d->shift);
     d->n_offset = malloc(cap * sizeof *d->n_offset);
     d->pos_l = malloc(3 * cap * sizeof *d->pos_l);
     d->pos_new = malloc(3 * cap * sizeof *d->pos_new);
     d->value = malloc(MAFL_MAX_CARRIED * cap * sizeof *d->value);
     d->convected = malloc(cap);
     d->remove = malloc(cap);
-    if (!d->n_offset || !d->pos_l || !d->pos_new || !d->value || !d->convected || !d->remove) {
+    if (!d->n_offset || !d->pos_l || !d->pos_new || !d->value || !d->convected || !d->remove ||
+        !d->shift) {
         d->cap = 0;
         return MF_ERROR(MF_ERR_MEMORY, "MPS-MAFL: out of memory for %zu points", n);
     }
@@ -61,6 +64,7 @@ static void mafl_destroy_data(mafl_data *d)
     free(d->convected);
     free(d->remove);
     free(d->n_offset);
+    free(d->shift);
     free(d);
 }
 
@@ -146,8 +150,9 @@ static void mafl_destroy(void *data) { mafl_destroy_data(data); }
 static void mafl_report(void *data, const mf_sim *sim, mf_log *log)
 {
     const mafl_data *d = data;
-    double points[2] = {(double)d->total_added, (double)d->total_removed}; /* every rank's */
-    mf_parallel_sum(sim->par, points, 2);
+    double points[3] = {(double)d->total_added, (double)d->total_removed,
+                        (double)d->total_separated}; /* every rank's */
+    mf_parallel_sum(sim->par, points, 3);
     /* Steps this run took (one explicit phase of the MPS module each);
      * sim->step counts from before a restart. */
     const double steps = d->mps->attempts > 0 ? (double)d->mps->attempts : 1.0;
@@ -158,9 +163,9 @@ static void mafl_report(void *data, const mf_sim *sim, mf_log *log)
                   1e3 * d->t_lagrangian / steps, 1e3 * d->t_reconfigure / steps,
                   1e3 * d->t_eulerian / steps, 1e3 * d->t_points / steps, 1e3 * total / steps);
     mf_log_printf(log, MF_LOG_QUIET,
-                  "MAFL points: added %.0f (eq. 22), removed %.0f over the run; %ld grid "
-                  "widenings where |u^a| dt > dr%s\n",
-                  points[0], points[1], d->q_limited, sim->par ? " (on rank 0)" : "");
+                  "MAFL points: added %.0f (eq. 22), removed %.0f over the run; %.0f moves apart "
+                  "(separation); %ld grid widenings where |u^a| dt > dr%s\n",
+                  points[0], points[1], points[2], d->q_limited, sim->par ? " (on rank 0)" : "");
 }
 
 const mf_solver_ops mf_solver_MAFL = {

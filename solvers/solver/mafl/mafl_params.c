@@ -51,4 +51,7 @@ const mf_param mafl_params[MAFL_NPARAMS] = {
     {"holeSpacing", MF_PARAM_BOOL, "yes", MF_NO_RANGE, NULL, MAFL_OFFSET(hole_spacing),
      "a new point goes l0 from its nearest point (along the line through the site) rather "
      "than onto the lattice site: holes found late by up to |u^c| dt are not packed"},
+    {"separation", MF_PARAM_SCALAR, "0.6", 0, 0.95, NULL, MAFL_OFFSET(separation),
+     "rules fraction and relax: fluid points closer than this (in l0) are moved apart, so that "
+     "they need not merge (a merge removes a point's volume; 0: never)"},
 };

@@ -132,7 +132,7 @@ typedef struct hole_ctx {
 } hole_ctx;
 
 typedef struct hole_acc {
-    double count, best, best_any;
+    double count, walls, best, best_any; /* walls: neighbours that carry no values */
     size_t closest, nearest;
     bool occupied; /* a point closer than dmin */
 } hole_acc;
@@ -149,8 +149,10 @@ static inline bool hole_point(void *acc, const void *ctx, size_t j, const double
         a->occupied = true;
         return false;
     }
-    if (dist < c->re)
+    if (dist < c->re) {
         a->count++;
+        a->walls += !carries_values(c->p->kind[j]);
+    }
     if (dist < a->best_any) {
         a->best_any = dist;
         a->nearest = j;
@@ -166,7 +168,12 @@ static inline bool hole_point(void *acc, const void *ctx, size_t j, const double
 
 /* Is the site x a hole? No point closer than holeDistance, and at least
  * holeDensity of a full lattice's neighbours within re (a count, not the
- * singular weight: one close point must not make an empty site look full).
+ * singular weight: one close point must not make an empty site look full),
+ * counted on the fluid's side: the fluid points among the sites that are
+ * not wall, fluid >= holeDensity (full - walls). Counted with the walls, a
+ * site above a free surface beside a wall has the wall above the surface
+ * to make it look full: on a resting box with moving points the contact
+ * lines grew a column of new points up each side wall (+5.5% in 2 s).
  * Then *closest is the nearest point carrying values and *nearest the
  * nearest point of any kind. */
 static bool is_hole(const mafl_data *d, const mf_particles *p, const double x[3], double l0,
@@ -174,13 +181,13 @@ static bool is_hole(const mafl_data *d, const mf_particles *p, const double x[3]
 {
     /* On several ranks ties are broken alike on every rank (lowest id). */
     const hole_ctx c = {d, p, d->s.hole_distance * l0, d->mps->k_nd.re, d->halo != NULL};
-    hole_acc a = {0, INFINITY, INFINITY, *closest, *nearest, false};
+    hole_acc a = {0, 0, INFINITY, INFINITY, *closest, *nearest, false};
     mf_grid_near(d->grid, x, hole_point, &c, &a);
     *closest = a.closest;
     *nearest = a.nearest;
     if (a.occupied)
         return false;
-    return isfinite(a.best) && a.count >= d->s.hole_density * full;
+    return isfinite(a.best) && a.count - a.walls >= d->s.hole_density * (full - a.walls);
 }
 
 /* A hole is found the first step its nearest point is more than

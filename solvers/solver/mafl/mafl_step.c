@@ -88,7 +88,8 @@ int mafl_copies(mafl_data *d, mf_sim *sim, double radius, bool values)
 /* How far the Eulerian phase reads from a point at r^L: its 1-D grid
  * reaches two spacings upstream, each spacing dr or |u^a| dt when longer,
  * and |u^a| dt = |r^L - r^{n+1}| is at most the Lagrangian displacement plus
- * the reconfiguration's largest shift (0.2 l0); then the disk of eq. 23. */
+ * the reconfiguration's largest shifts (0.2 l0 of the rule or the surface,
+ * 0.2 l0 of the separation); then the disk of eq. 23. */
 static double eulerian_reach(const mafl_data *d, const mf_sim *sim)
 {
     const mf_particles *p = sim->p;
@@ -101,7 +102,7 @@ static double eulerian_reach(const mafl_data *d, const mf_sim *sim)
         moved = fmax(moved, sqrt(r2));
     }
     mf_parallel_max(sim->par, &moved, 1);
-    const double l0 = sim->l0, travel = moved + 0.2 * l0;
+    const double l0 = sim->l0, travel = moved + 0.4 * l0;
     return 2.0 * fmax(d->s.grid_spacing * l0, travel) + d->s.re_interpolation * l0;
 }
 
@@ -147,7 +148,9 @@ int mafl_step(mafl_data *d, mf_sim *sim, double dt)
     /* 4. Where the number of points changes (eq. 22). */
     MF_CALL(mafl_update_points(d, sim));
     d->t_points += mf_wall_seconds() - t3;
-    mf_log_printf(sim->log, MF_LOG_STEP, "MAFL: points added %zu, removed %zu; max q %.3g\n",
-                  d->last_added, d->last_removed, d->q_max);
+    d->total_separated += d->last_separated;
+    mf_log_printf(sim->log, MF_LOG_STEP,
+                  "MAFL: points added %zu, removed %zu, moved apart %zu; max q %.3g\n",
+                  d->last_added, d->last_removed, d->last_separated, d->q_max);
     return 0;
 }
