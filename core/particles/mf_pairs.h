@@ -41,6 +41,19 @@
 
 #define MF_ENGINE static inline __attribute__((always_inline))
 
+/* Threads on a machine that has other work. A loop's iterations are dealt
+ * dynamically, MF_PAIRS_CHUNK rows (of pairs) or MF_STREAM_CHUNK items (of
+ * a few operations each) at a time: a thread that another process holds
+ * off its core then delays the loop by one chunk, not by its static half
+ * (with a static schedule the loop lasts as long as the slowest thread's
+ * half, and two threads with the second core busy were no faster than
+ * one). A loop of a few operations an item runs in parallel from
+ * MF_STREAM_MIN items on only: below, waking the team (passive wait: a
+ * futex and the scheduler) costs more than the loop. */
+#define MF_PAIRS_CHUNK 64
+#define MF_STREAM_CHUNK 4096
+#define MF_STREAM_MIN 32768
+
 /* A neighbour view: lists and the radius of one request. */
 typedef struct mf_pairs {
     const double *pos;       /* 3 per particle */
@@ -139,7 +152,7 @@ MF_ENGINE void mf_pairs_each(const mf_pairs *v, const uint8_t *imask, mf_row_fn 
                              const void *ctx)
 {
     const long n = (long)v->ni;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(dynamic, MF_PAIRS_CHUNK)
     for (long i = 0; i < n; i++)
         if (!imask || imask[i])
             row(ctx, (size_t)i);
