@@ -243,15 +243,20 @@ typedef int (*mf_assemble_sized_fn)(void *ctx, size_t nnz);
 
 /* The matrix of the owned particles i with col_of[i] >= 0 (their rows in
  * particle order: rows->col_of[i] = 0, 1, ... over them) in one pass over
- * the pairs. A row has at most 1 + its particle's list length entries: the
- * particles are cut into chunks, each chunk's rows are written packed from
- * the sum of the bounds of the rows before it (in parallel, a chunk at a
- * time), then the chunks are moved down onto each other. The rows, their
- * entries and rowptr come out as a count pass, a prefix sum and a writing
- * pass would give them, for any thread count; the gaps between chunks are
- * a few pages never written, so the memory touched is the matrix's. sized()
- * gets the bound and may move rows->rowptr, col and val. Returns in
- * *failed the first failed particle, or SIZE_MAX. */
+ * the pairs. A row has at most 1 + its particle's list length entries (the
+ * bound). The particles are cut into chunks, dealt to the threads in order
+ * (dynamically, for a thread held off its core by another process); a
+ * chunk's rows are written packed from where the chunks dealt before it can
+ * end at most: the end of the last one if it is done, else its start plus
+ * its bound (a chunk done while it is the last dealt gives its unused
+ * bound back). Then the chunks are moved down onto each other. With one
+ * thread every chunk starts where the one before ended: nothing moves and
+ * the memory written is the matrix's; with more, a chunk dealt while
+ * another was being written leaves that chunk's unused bound as a gap.
+ * Rows, entries and rowptr are those of a count pass, a prefix sum and a
+ * writing pass, for any thread count. sized() gets the bound of all rows
+ * and may move rows->rowptr, col and val. Returns in *failed the first
+ * failed particle, or SIZE_MAX. */
 MF_ENGINE int mf_pairs_assemble(const mf_pairs *v, mf_rows *rows, size_t nrows,
                                 mf_assemble_sized_fn sized, mf_assemble_row_fn row, void *ctx,
                                 size_t *failed)
@@ -260,35 +265,55 @@ MF_ENGINE int mf_pairs_assemble(const mf_pairs *v, mf_rows *rows, size_t nrows,
     const long *col_of = rows->col_of;
     const size_t per = n / MF_ASSEMBLE_CHUNKS + 1;
     const long nchunks = (long)((n + per - 1) / per);
-    size_t base[MF_ASSEMBLE_CHUNKS + 1], len[MF_ASSEMBLE_CHUNKS + 1];
-    size_t bound = 0;
+    size_t bound[MF_ASSEMBLE_CHUNKS], base[MF_ASSEMBLE_CHUNKS], len[MF_ASSEMBLE_CHUNKS];
+    size_t total = 0;
     for (long c = 0; c < nchunks; c++) {
-        base[c] = bound;
         const size_t i1 = (size_t)(c + 1) * per < n ? (size_t)(c + 1) * per : n;
+        bound[c] = 0;
         for (size_t i = (size_t)c * per; i < i1; i++)
             if (col_of[i] >= 0)
-                bound += 1 + (size_t)(v->start[i + 1] - v->start[i]);
+                bound[c] += 1 + (size_t)(v->start[i + 1] - v->start[i]);
+        total += bound[c];
     }
-    int rc = sized(ctx, bound);
+    int rc = sized(ctx, total);
     if (rc != 0)
         return rc;
     size_t *rowptr = rows->rowptr;
-    size_t first = SIZE_MAX;
-#pragma omp parallel for schedule(dynamic, 1) reduction(min : first)
-    for (long c = 0; c < nchunks; c++) {
-        size_t at = base[c];
-        const size_t i1 = (size_t)(c + 1) * per < n ? (size_t)(c + 1) * per : n;
-        for (size_t i = (size_t)c * per; i < i1; i++) {
-            const long r = col_of[i];
-            if (r < 0)
-                continue;
-            rowptr[r] = at;
-            const size_t m = row(ctx, i, (size_t)r);
-            if (m == 0 && i < first)
-                first = i;
-            at += m;
+    size_t first = SIZE_MAX, next_base = 0;
+    long next_chunk = 0;
+#pragma omp parallel
+    {
+        size_t my_first = SIZE_MAX;
+        for (;;) {
+            long c = -1;
+#pragma omp critical(mf_pairs_assemble)
+            if (next_chunk < nchunks) {
+                c = next_chunk++;
+                base[c] = next_base;
+                next_base += bound[c];
+            }
+            if (c < 0)
+                break;
+            size_t at = base[c];
+            const size_t i1 = (size_t)(c + 1) * per < n ? (size_t)(c + 1) * per : n;
+            for (size_t i = (size_t)c * per; i < i1; i++) {
+                const long r = col_of[i];
+                if (r < 0)
+                    continue;
+                rowptr[r] = at;
+                const size_t m = row(ctx, i, (size_t)r);
+                if (m == 0 && i < my_first)
+                    my_first = i;
+                at += m;
+            }
+            len[c] = at - base[c];
+#pragma omp critical(mf_pairs_assemble)
+            if (c == next_chunk - 1) /* the last dealt: its unused bound back */
+                next_base = at;
         }
-        len[c] = at - base[c];
+#pragma omp critical(mf_pairs_assemble)
+        if (my_first < first)
+            first = my_first;
     }
     /* The chunks down onto each other, in order (each moves down or stays). */
     int32_t *col = rows->col;
@@ -296,14 +321,16 @@ MF_ENGINE int mf_pairs_assemble(const mf_pairs *v, mf_rows *rows, size_t nrows,
     size_t at = 0;
     for (long c = 0; c < nchunks; c++) {
         const size_t shift = base[c] - at;
-        if (shift > 0 && len[c] > 0) {
-            memmove(col + at, col + base[c], len[c] * sizeof *col);
-            memmove(val + at, val + base[c], len[c] * sizeof *val);
+        if (shift > 0) {
+            if (len[c] > 0) {
+                memmove(col + at, col + base[c], len[c] * sizeof *col);
+                memmove(val + at, val + base[c], len[c] * sizeof *val);
+            }
+            const size_t i1 = (size_t)(c + 1) * per < n ? (size_t)(c + 1) * per : n;
+            for (size_t i = (size_t)c * per; i < i1; i++)
+                if (col_of[i] >= 0)
+                    rowptr[col_of[i]] -= shift;
         }
-        const size_t i1 = (size_t)(c + 1) * per < n ? (size_t)(c + 1) * per : n;
-        for (size_t i = (size_t)c * per; i < i1; i++)
-            if (col_of[i] >= 0)
-                rowptr[col_of[i]] -= shift;
         at += len[c];
     }
     rowptr[nrows] = at;
