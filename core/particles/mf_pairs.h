@@ -47,12 +47,10 @@
  * off its core then delays the loop by one chunk, not by its static half
  * (with a static schedule the loop lasts as long as the slowest thread's
  * half, and two threads with the second core busy were no faster than
- * one). A loop of a few operations an item runs in parallel from
- * MF_STREAM_MIN items on only: below, waking the team (passive wait: a
- * futex and the scheduler) costs more than the loop. */
+ * one). Small loops stay parallel too: run on one thread they were slower
+ * on a loaded machine (docs/notes/speed.md, speed3). */
 #define MF_PAIRS_CHUNK 64
 #define MF_STREAM_CHUNK 4096
-#define MF_STREAM_MIN 32768
 
 /* A neighbour view: lists and the radius of one request. */
 typedef struct mf_pairs {
