@@ -487,12 +487,6 @@ static inline void w_known(void *acc, const void *ctx, const mf_pair *pr, double
     *(double *)acc += a * c->known_value[pr->j];
 }
 
-static size_t w_count(const void *ctx, size_t i)
-{
-    const lap_rows *c = ctx;
-    return mf_pairs_row_count(&c->v, i, NULL, NULL, c, c->rows.col_of);
-}
-
 static int w_sized(void *ctx, size_t nnz)
 {
     lap_rows *c = ctx;
@@ -502,16 +496,17 @@ static int w_sized(void *ctx, size_t nnz)
     return c->rows.col && c->rows.val ? 0 : MF_ERR_MEMORY;
 }
 
-static bool w_row(const void *ctx, size_t i, size_t r)
+static size_t w_row(const void *ctx, size_t i, size_t r)
 {
     const lap_rows *c = ctx;
     double known = 0;
+    size_t entries = 0;
     double sum = mf_pairs_row_assemble(&c->v, i, NULL, NULL, w_coef, w_known, c, &known,
-                                       &c->rows, r);
+                                       &c->rows, r, &entries);
     c->rows.val[c->rows.rowptr[r]] = 1.0 + sum;
     c->diag_sum[r] = sum;
     c->known[r] = known;
-    return true;
+    return entries;
 }
 
 /* Rows of the unknowns (fluid here): diagonal first, -a_ij in unknown j's
@@ -531,8 +526,7 @@ static void check_assembly(const mf_particles *p, const mf_pairs *v, double cell
     lap_rows c = {*v, {col_of, 7, calloc(rows + 1, sizeof(size_t)), NULL, NULL, NULL}, value,
                   calloc(rows + 1, sizeof(double)), calloc(rows + 1, sizeof(double)), 0};
     size_t failed = 0;
-    CHECK_OK(mf_pairs_assemble(v, col_of, c.rows.rowptr, rows, w_count, w_sized, w_row, &c,
-                               &failed));
+    CHECK_OK(mf_pairs_assemble(v, &c.rows, rows, w_sized, w_row, &c, &failed));
     CHECK(failed == SIZE_MAX);
     brute b = brute_pairs(p, v->radius, cell);
     size_t bad_rows = 0, asym = 0;

@@ -19,6 +19,7 @@
  * The neighbour lists built on this grid are in nlist.c.
  */
 #include "neighbours_internal.h"
+#include "mf_pairs.h" /* the threads policy: MF_STREAM_CHUNK */
 
 /* ---- grid: memory ----------------------------------------------------- */
 
@@ -251,8 +252,8 @@ static int bounding_box(const mf_particles *p, size_t n, double lo[3], double hi
     double x0 = INFINITY, y0 = INFINITY, z0 = INFINITY;
     double x1 = -INFINITY, y1 = -INFINITY, z1 = -INFINITY;
     size_t bad = 0;
-#pragma omp parallel for schedule(static) reduction(min : x0, y0, z0) \
-    reduction(max : x1, y1, z1) reduction(+ : bad)
+#pragma omp parallel for schedule(dynamic, MF_STREAM_CHUNK) \
+    reduction(min : x0, y0, z0) reduction(max : x1, y1, z1) reduction(+ : bad)
     for (size_t i = 0; i < n; i++) {
         const double *x = pos + 3 * i;
         double z = dim == 3 ? x[2] : 0.0;
@@ -389,7 +390,7 @@ int mf_grid_keys(const mf_particles *p, double cell_size, uint64_t *keys, bool *
      * does; with at most 32 bits it leaves room for the index. */
     const bool pack = f.axis_bits[0] + f.axis_bits[1] + f.axis_bits[2] <= 32;
     *packed = pack;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(dynamic, MF_STREAM_CHUNK)
     for (long i = 0; i < np; i++) {
         const double *x = pos + 3 * i;
         uint64_t k = cell_coord(x[0], f.origin[0], f.inv_width) |
@@ -437,7 +438,7 @@ int mf_grid_build_reach(mf_grid *g, const mf_particles *p, double cell_size, int
         const int sy = axis_bits[0], sz = axis_bits[0] + axis_bits[1];
         uint64_t *key = g->sort_key;
         uint32_t *idx = g->sort_idx;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(dynamic, MF_STREAM_CHUNK)
         for (size_t i = 0; i < np; i++) {
             const double *x = pos + 3 * i;
             uint64_t k = cell_coord(x[0], o0, inv_width) | cell_coord(x[1], o1, inv_width) << sy;
@@ -482,7 +483,7 @@ int mf_grid_build_reach(mf_grid *g, const mf_particles *p, double cell_size, int
         mf_hashmap_put_new(&g->cells, g->cell_key[c], (uint32_t)c);
 
     /* Rows of neighbouring cells, once per cell for all later list builds. */
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(dynamic, MF_PAIRS_CHUNK)
     for (size_t c = 0; c < ncells; c++)
         find_rows(g, c, reach, g->cell_rows + c * (size_t)nrows);
 
@@ -491,7 +492,7 @@ int mf_grid_build_reach(mf_grid *g, const mf_particles *p, double cell_size, int
         const double *pos = p->pos;
         uint32_t *order = g->order;
         double *sx = g->spos, *sy = g->spos + np, *sz = g->spos + 2 * np;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(dynamic, MF_STREAM_CHUNK)
         for (size_t k = 0; k < np; k++) {
             size_t i = sidx[k];
             order[k] = (uint32_t)i;

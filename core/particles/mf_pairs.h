@@ -9,10 +9,10 @@
  *   mf_pairs_each      the rows of the owned particles i in imask, in
  *                      parallel (OpenMP): the operator's row function calls
  *                      mf_pairs_row and stores its result;
- *   mf_pairs_row_count / mf_pairs_row_assemble / mf_pairs_assemble
+ *   mf_pairs_row_assemble / mf_pairs_assemble
  *                      matrix rows from a coefficient kernel a_ij (the
  *                      assemble sink): diagonal first, -a_ij for a neighbour
- *                      with a column, a known value otherwise;
+ *                      with a column, a known value otherwise, in one pass;
  *   mf_grid_near       the particles of a grid near any point (point
  *                      queries: MPS-MAFL's grid points and lattice sites).
  *
@@ -34,11 +34,23 @@
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 
 #include "mf_neighbours.h"
 #include "mf_particles.h"
 
 #define MF_ENGINE static inline __attribute__((always_inline))
+
+/* Threads on a machine that has other work. A loop's iterations are dealt
+ * dynamically, MF_PAIRS_CHUNK rows (of pairs) or MF_STREAM_CHUNK items (of
+ * a few operations each) at a time: a thread that another process holds
+ * off its core then delays the loop by one chunk, not by its static half
+ * (with a static schedule the loop lasts as long as the slowest thread's
+ * half, and two threads with the second core busy were no faster than
+ * one). Small loops stay parallel too: run on one thread they were slower
+ * on a loaded machine (docs/notes/speed.md, speed3). */
+#define MF_PAIRS_CHUNK 64
+#define MF_STREAM_CHUNK 4096
 
 /* A neighbour view: lists and the radius of one request. */
 typedef struct mf_pairs {
@@ -138,7 +150,7 @@ MF_ENGINE void mf_pairs_each(const mf_pairs *v, const uint8_t *imask, mf_row_fn 
                              const void *ctx)
 {
     const long n = (long)v->ni;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(dynamic, MF_PAIRS_CHUNK)
     for (long i = 0; i < n; i++)
         if (!imask || imask[i])
             row(ctx, (size_t)i);
@@ -168,43 +180,16 @@ typedef double (*mf_pair_coef)(const void *ctx, const mf_pair *pr);
  * right-hand side (acc). */
 typedef void (*mf_pair_known)(void *acc, const void *ctx, const mf_pair *pr, double a);
 
-/* Entries of the row of particle i: 1 (the diagonal) and one per taking
- * part neighbour with a column. */
-MF_ENGINE size_t mf_pairs_row_count(const mf_pairs *v, size_t i, const uint8_t *jmask,
-                                    mf_pair_test test, const void *ctx, const long *col_of)
-{
-    /* A local copy: its fields stay in registers across the kernel's calls. */
-    const mf_pairs w = *v;
-    const double *pos = w.pos;
-    const double xi = pos[3 * i], yi = pos[3 * i + 1], zi = pos[3 * i + 2];
-    size_t count = 1;
-    mf_pair pr;
-    pr.i = i;
-    for (uint32_t k = w.start[i], end = w.start[i + 1]; k < end; k++) {
-        const size_t j = w.j[k];
-        if ((jmask && !jmask[j]) || col_of[j] < 0)
-            continue;
-        /* Without a test the square root is not needed (the compiler drops
-         * it with the unused pair, but not the errno check of a NaN). */
-        if (!test) {
-            const double *xj = pos + 3 * j;
-            const double dx = xj[0] - xi, dy = xj[1] - yi, dz = xj[2] - zi;
-            count += dx * dx + dy * dy + dz * dz < w.r2;
-        } else if (mf_pairs_entry(&w, k, xi, yi, zi, &pr) && test(ctx, &pr)) {
-            count++;
-        }
-    }
-    return count;
-}
-
 /* Writes the row of particle i at rows->rowptr[row]: the diagonal's column
  * first (its value is the caller's: returned is the sum of a_ij over the
  * taking part pairs, known ones included), then -a_ij for each neighbour
- * with a column, in the view's order; known(acc, ...) for the others. */
+ * with a column, in the view's order; known(acc, ...) for the others.
+ * *entries: the row's entries, the diagonal included (at most 1 + the
+ * particle's list length, which mf_pairs_assemble reserves). */
 MF_ENGINE double mf_pairs_row_assemble(const mf_pairs *v, size_t i, const uint8_t *jmask,
                                        mf_pair_test test, mf_pair_coef coef,
                                        mf_pair_known known, const void *ctx, void *acc,
-                                       const mf_rows *rows, size_t row)
+                                       const mf_rows *rows, size_t row, size_t *entries)
 {
     const mf_pairs w = *v;
     const double *pos = w.pos;
@@ -235,50 +220,118 @@ MF_ENGINE double mf_pairs_row_assemble(const mf_pairs *v, size_t i, const uint8_
             known(acc, ctx, &pr, a);
         }
     }
+    *entries = at - rows->rowptr[row];
     return sum;
 }
 
-/* The entries of the row of particle i (mf_pairs_row_count with the
- * assembly's kernels), and the writing of its row r (of the particle i with
- * col_of[i] == r; mf_pairs_row_assemble, then the diagonal and the
- * right-hand side). A row function returns false to report the row as
- * failed: the assembly goes on, and the smallest failed particle is
- * reported. Both are called through the pointer once a row; the kernels
- * inside them are inlined. */
-typedef size_t (*mf_count_row_fn)(const void *ctx, size_t i);
-typedef bool (*mf_assemble_row_fn)(const void *ctx, size_t i, size_t row);
-/* Called between the passes with the entry count: sizes the column and
- * value arrays; nonzero stops the assembly. */
+/* The writing of row r of the particle i with col_of[i] == r
+ * (mf_pairs_row_assemble, then the diagonal and the right-hand side):
+ * returns the row's entries, or 0 to report the row as failed (its entries
+ * are dropped; the assembly goes on, and the smallest failed particle is
+ * reported). Called through the pointer once a row; the kernels inside it
+ * are inlined. */
+typedef size_t (*mf_assemble_row_fn)(const void *ctx, size_t i, size_t row);
+/* Called before the rows are written with a bound on the entries: sizes
+ * the column and value arrays (rows->col, rows->val); nonzero stops the
+ * assembly. */
 typedef int (*mf_assemble_sized_fn)(void *ctx, size_t nnz);
 
+/* Chunks of particles the rows are written in (at most). */
+#define MF_ASSEMBLE_CHUNKS 256
+
 /* The matrix of the owned particles i with col_of[i] >= 0 (their rows in
- * particle order: col_of[i] = 0, 1, ... over them): a parallel count pass
- * fills rowptr, then sized(), then a parallel pass writes the rows. Returns
- * in *failed the first failed particle, or SIZE_MAX. */
-MF_ENGINE int mf_pairs_assemble(const mf_pairs *v, const long *col_of, size_t *rowptr,
-                                size_t nrows, mf_count_row_fn count, mf_assemble_sized_fn sized,
-                                mf_assemble_row_fn row, void *ctx, size_t *failed)
+ * particle order: rows->col_of[i] = 0, 1, ... over them) in one pass over
+ * the pairs. A row has at most 1 + its particle's list length entries (the
+ * bound). The particles are cut into chunks, dealt to the threads in order
+ * (dynamically, for a thread held off its core by another process); a
+ * chunk's rows are written packed from where the chunks dealt before it can
+ * end at most: the end of the last one if it is done, else its start plus
+ * its bound (a chunk done while it is the last dealt gives its unused
+ * bound back). Then the chunks are moved down onto each other. With one
+ * thread every chunk starts where the one before ended: nothing moves and
+ * the memory written is the matrix's; with more, a chunk dealt while
+ * another was being written leaves that chunk's unused bound as a gap.
+ * Rows, entries and rowptr are those of a count pass, a prefix sum and a
+ * writing pass, for any thread count. sized() gets the bound of all rows
+ * and may move rows->rowptr, col and val. Returns in *failed the first
+ * failed particle, or SIZE_MAX. */
+MF_ENGINE int mf_pairs_assemble(const mf_pairs *v, mf_rows *rows, size_t nrows,
+                                mf_assemble_sized_fn sized, mf_assemble_row_fn row, void *ctx,
+                                size_t *failed)
 {
-    const long n = (long)v->ni;
-#pragma omp parallel for schedule(static)
-    for (long i = 0; i < n; i++) {
-        const long r = col_of[i];
-        if (r >= 0)
-            rowptr[r + 1] = count(ctx, (size_t)i);
+    const size_t n = v->ni;
+    const long *col_of = rows->col_of;
+    const size_t per = n / MF_ASSEMBLE_CHUNKS + 1;
+    const long nchunks = (long)((n + per - 1) / per);
+    size_t bound[MF_ASSEMBLE_CHUNKS], base[MF_ASSEMBLE_CHUNKS], len[MF_ASSEMBLE_CHUNKS];
+    size_t total = 0;
+    for (long c = 0; c < nchunks; c++) {
+        const size_t i1 = (size_t)(c + 1) * per < n ? (size_t)(c + 1) * per : n;
+        bound[c] = 0;
+        for (size_t i = (size_t)c * per; i < i1; i++)
+            if (col_of[i] >= 0)
+                bound[c] += 1 + (size_t)(v->start[i + 1] - v->start[i]);
+        total += bound[c];
     }
-    rowptr[0] = 0;
-    for (size_t r = 0; r < nrows; r++)
-        rowptr[r + 1] += rowptr[r];
-    int rc = sized(ctx, rowptr[nrows]);
+    int rc = sized(ctx, total);
     if (rc != 0)
         return rc;
-    size_t first = SIZE_MAX;
-#pragma omp parallel for schedule(static) reduction(min : first)
-    for (long i = 0; i < n; i++) {
-        const long r = col_of[i];
-        if (r >= 0 && !row(ctx, (size_t)i, (size_t)r) && (size_t)i < first)
-            first = (size_t)i;
+    size_t *rowptr = rows->rowptr;
+    size_t first = SIZE_MAX, next_base = 0;
+    long next_chunk = 0;
+#pragma omp parallel
+    {
+        size_t my_first = SIZE_MAX;
+        for (;;) {
+            long c = -1;
+#pragma omp critical(mf_pairs_assemble)
+            if (next_chunk < nchunks) {
+                c = next_chunk++;
+                base[c] = next_base;
+                next_base += bound[c];
+            }
+            if (c < 0)
+                break;
+            size_t at = base[c];
+            const size_t i1 = (size_t)(c + 1) * per < n ? (size_t)(c + 1) * per : n;
+            for (size_t i = (size_t)c * per; i < i1; i++) {
+                const long r = col_of[i];
+                if (r < 0)
+                    continue;
+                rowptr[r] = at;
+                const size_t m = row(ctx, i, (size_t)r);
+                if (m == 0 && i < my_first)
+                    my_first = i;
+                at += m;
+            }
+            len[c] = at - base[c];
+#pragma omp critical(mf_pairs_assemble)
+            if (c == next_chunk - 1) /* the last dealt: its unused bound back */
+                next_base = at;
+        }
+#pragma omp critical(mf_pairs_assemble)
+        if (my_first < first)
+            first = my_first;
     }
+    /* The chunks down onto each other, in order (each moves down or stays). */
+    int32_t *col = rows->col;
+    double *val = rows->val;
+    size_t at = 0;
+    for (long c = 0; c < nchunks; c++) {
+        const size_t shift = base[c] - at;
+        if (shift > 0) {
+            if (len[c] > 0) {
+                memmove(col + at, col + base[c], len[c] * sizeof *col);
+                memmove(val + at, val + base[c], len[c] * sizeof *val);
+            }
+            const size_t i1 = (size_t)(c + 1) * per < n ? (size_t)(c + 1) * per : n;
+            for (size_t i = (size_t)c * per; i < i1; i++)
+                if (col_of[i] >= 0)
+                    rowptr[col_of[i]] -= shift;
+        }
+        at += len[c];
+    }
+    rowptr[nrows] = at;
     *failed = first;
     return 0;
 }

@@ -229,7 +229,8 @@ static double displacement(const nb_class *c, const mf_particles *p)
     const bool three = p->dim == 3;
     size_t moved_slots = 0;
     double d2max = 0;
-#pragma omp parallel for schedule(static) reduction(+ : moved_slots) reduction(max : d2max)
+#pragma omp parallel for schedule(dynamic, MF_STREAM_CHUNK) \
+    reduction(+ : moved_slots) reduction(max : d2max)
     for (size_t k = 0; k < np; k++) {
         const size_t i = order[k];
         moved_slots += id[i] != id0[k];

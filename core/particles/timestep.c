@@ -3,11 +3,14 @@
 
 #include <math.h>
 
+#include "mf_pairs.h" /* the threads policy: MF_STREAM_CHUNK */
+
 double mf_max_fluid_speed(const mf_particles *p)
 {
     double u2max = 0.0;
     const long n = (long)p->n_owned;
-#pragma omp parallel for reduction(max : u2max) schedule(static)
+#pragma omp parallel for schedule(dynamic, MF_STREAM_CHUNK) \
+    reduction(max : u2max)
     for (long i = 0; i < n; i++) {
         if (p->kind[i] != MF_FLUID)
             continue;

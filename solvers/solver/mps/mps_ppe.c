@@ -196,17 +196,19 @@ static inline void ppe_known(void *acc, const void *ctx, const mf_pair *pr, doub
     }
 }
 
-/* false: a fluid particle with no non-dummy neighbour (reported by the caller). */
-static bool ppe_row(const void *ctx, size_t i, size_t r)
+/* The row's entries; 0: a fluid particle with no non-dummy neighbour
+ * (reported by the caller). */
+static size_t ppe_row(const void *ctx, size_t i, size_t r)
 {
     const ppe_ctx *c = ctx;
     mps_data *d = c->d;
     ppe_acc acc = {0.0, false};
     const size_t diag = c->rows.rowptr[r];
+    size_t entries = 0;
     const double sum = mf_pairs_row_assemble(&c->v, i, d->not_dummy, NULL, ppe_coef, ppe_known,
-                                             c, &acc, &c->rows, r);
+                                             c, &acc, &c->rows, r, &entries);
     if (!(sum > 0) && d->is_fluid[i] && !d->wall)
-        return false; /* (wall weight: a particle with only the wall near takes p = 0 below) */
+        return 0; /* (wall weight: a particle with only the wall near takes p = 0 below) */
     const double dt2 = c->dt * c->dt;
     /* n* - n0, or against a per-particle reference (mps_data.n_offset) */
     const double dn = d->n_offset ? c->n[i] - c->n0 - d->n_offset[i] : c->n[i] - c->n0;
@@ -233,16 +235,10 @@ static bool ppe_row(const void *ctx, size_t i, size_t r)
     if (d->s.compressibility > 0)
         c->touches[r] = 1;
     d->x[r] = c->pressure[i]; /* warm start from the last step */
-    return true;
+    return entries;
 }
 
-static size_t ppe_count(const void *ctx, size_t i)
-{
-    const ppe_ctx *c = ctx;
-    return mf_pairs_row_count(&c->v, i, c->d->not_dummy, NULL, c, c->rows.col_of);
-}
-
-/* Between the count and the fill: room for the entries. */
+/* Before the rows: room for the entries (a bound, mf_pairs_assemble). */
 static int ppe_sized(void *ctx, size_t nnz)
 {
     ppe_ctx *c = ctx;
@@ -313,8 +309,7 @@ int mps_assemble_ppe(mps_data *d, const mf_sim *sim, double dt)
     c.re = c.v.radius;
     size_t failed = SIZE_MAX;
     if (rc == 0)
-        rc = mf_pairs_assemble(&c.v, d->row, A->rowptr, nrows, ppe_count, ppe_sized, ppe_row, &c,
-                               &failed);
+        rc = mf_pairs_assemble(&c.v, &c.rows, nrows, ppe_sized, ppe_row, &c, &failed);
     if (rc == 0 && failed != SIZE_MAX) {
         /* n* counts dummy particles, the Laplacian does not: a fluid
          * particle with only dummies within re is inside a wall, and its

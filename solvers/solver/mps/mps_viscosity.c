@@ -144,22 +144,17 @@ static inline void visc_known(void *acc, const void *ctx, const mf_pair *pr, dou
         known[q] += a * c->vel[3 * pr->j + q];
 }
 
-static bool visc_row(const void *ctx, size_t i, size_t r)
+static size_t visc_row(const void *ctx, size_t i, size_t r)
 {
     const visc_ctx *c = ctx;
     const mps_data *d = c->d;
     double known[3] = {0.0, 0.0, 0.0};
+    size_t entries = 0;
     const double sum = mf_pairs_row_assemble(&c->v, i, NULL, visc_takes_part, visc_coef,
-                                             visc_known, c, known, &c->rows, r);
+                                             visc_known, c, known, &c->rows, r, &entries);
     d->visc->A.val[c->rows.rowptr[r]] = (d->rho ? d->rho[i] : 1.0) + sum;
     memcpy(&c->dirichlet[3 * r], known, sizeof known);
-    return true;
-}
-
-static size_t visc_count(const void *ctx, size_t i)
-{
-    const visc_ctx *c = ctx;
-    return mf_pairs_row_count(&c->v, i, NULL, visc_takes_part, c, c->rows.col_of);
+    return entries;
 }
 
 static int visc_sized(void *ctx, size_t nnz)
@@ -191,8 +186,7 @@ static int assemble(mps_data *d, const mf_sim *sim, double dt, double *dirichlet
     MF_CALL(mps_pairs(d, sim, d->h_lap, &c.v));
     c.re = c.v.radius;
     size_t failed;
-    MF_CALL(mf_pairs_assemble(&c.v, v->row, A->rowptr, A->nrows, visc_count, visc_sized, visc_row,
-                              &c, &failed));
+    MF_CALL(mf_pairs_assemble(&c.v, &c.rows, A->nrows, visc_sized, visc_row, &c, &failed));
     return 0;
 }
 
