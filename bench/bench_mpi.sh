@@ -9,6 +9,10 @@
 # np = 2 with 1 thread a rank: the same two cores either way.
 #
 #   bench/bench_mpi.sh dambreak [WORKDIR]   damBreak3D at ~1,000,000 particles
+#   bench/bench_mpi.sh dambreak100k [WORKDIR]  damBreak3D at l0 0.009 m (97,542
+#                                           particles), 5 and 25 steps: the
+#                                           quiet-machine figure of
+#                                           docs/topics/parallel.md (83 s)
 #   bench/bench_mpi.sh scenes [WORKDIR]     the paper's scenes at its counts
 #   bench/bench_mpi.sh all [WORKDIR]        both (default)
 #   bench/bench_mpi.sh quick [WORKDIR]      small versions: checks the script
@@ -154,8 +158,9 @@ scene() {
 case $WHAT in
 quick) dambreak ;;
 dambreak) dambreak ;;
+dambreak100k) DAMBREAK_L0=0.009; DAMBREAK_STEPS="5 25"; dambreak ;;
 scenes) scene corridorFlood 0.0215 && scene boxFilling 0.0117 ;;
 all) dambreak && scene corridorFlood 0.0215 && scene boxFilling 0.0117 ;;
-*) echo "usage: bench/bench_mpi.sh [dambreak|scenes|all|quick] [WORKDIR]"; exit 2 ;;
+*) echo "usage: bench/bench_mpi.sh [dambreak|dambreak100k|scenes|all|quick] [WORKDIR]"; exit 2 ;;
 esac
 echo "table: $csv" >&2

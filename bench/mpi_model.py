@@ -59,9 +59,12 @@ def main():
     ap.add_argument("--f", type=float, default=0.5, help="the PPE solve's share of a serial step")
     ap.add_argument("--g", type=float, default=0.5, help="cost of a halo copy / an owned particle")
     ap.add_argument("--k", type=float, default=3.1, help="halo depth in spacings (largest radius)")
-    ap.add_argument("--q", type=float, default=2.75,
-                    help="the solve's work a row on N ranks over the serial's (hypre's hierarchy "
-                         "set up each solve against the serial V-cycle's kept one; 1: the same)")
+    ap.add_argument("--q", type=float, default=2.0,
+                    help="the solve's work a row on N ranks over the serial's (hypre's PCG and "
+                         "V-cycle on a kept hierarchy against the serial run's own V-cycle: "
+                         "2,043 M instructions of hypre a rank on 2 ranks against the serial "
+                         "solve's 1,974 M, docs/topics/parallel.md, mpi4; 2.75 when hypre's "
+                         "hierarchy was set up each solve; 1: the same)")
     ap.add_argument("--iters", type=float, default=9.2, help="PCG iterations on one rank")
     ap.add_argument("--a", type=float, default=0.05, help="iteration growth per doubling of P")
     ap.add_argument("--exchanges", type=float, default=8, help="halo builds + updates + migration a step")

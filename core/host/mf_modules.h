@@ -77,6 +77,7 @@ typedef struct mf_solve_report {
     double final_residual;   /* ||b - A x|| / ||b|| */
     bool converged;
     double setup_seconds, solve_seconds;
+    int setups; /* preconditioner set-ups this solve made (0: a kept one served) */
 } mf_solve_report;
 
 typedef struct mf_pressure_ops {

@@ -8,6 +8,7 @@
 #include "mf_clock.h"
 #include "mf_error.h"
 #include "mf_modules.h"
+#include "mf_parallel.h"
 
 static int fault_point(const mf_sim *sim, mf_fault_site site, const char *module,
                        double *values, size_t n, int rc)
@@ -158,6 +159,13 @@ int mf_pressure_solve_rows(mf_module *m, const mf_sim *sim, const char *field, c
     rc = fault_point(sim, MF_FAULT_PRESSURE, m->info->name, x, A ? A->nrows : 0, rc);
     m->calls++;
     m->seconds += mf_wall_seconds() - t0;
+    mf_parallel_stats *st = mf_parallel_statistics(sim->par); /* NULL: a serial run */
+    if (st) {
+        st->solves++;
+        st->solve_setups += rep->setups;
+        st->t_solve_setup += rep->setup_seconds;
+        st->t_solve_iterate += rep->solve_seconds;
+    }
     mf_log_printf(sim->log, MF_LOG_STEP,
                   "%s:  Solving for %s, Initial residual = %g, Final residual = %g, No "
                   "Iterations %d\n",

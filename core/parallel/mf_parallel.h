@@ -84,6 +84,13 @@ typedef struct mf_parallel_stats {
     size_t halo_particles;  /* copies received, summed over builds */
     size_t halo_sent_bytes; /* bytes sent by halo builds and updates */
     size_t owned_at_builds; /* owned particles, summed over builds */
+    /* The linear solves through the pressure modules (the PPE and the
+     * implicit viscosity's systems; core/host's mf_pressure_solve_rows
+     * counts them): solves, the preconditioner set-ups they made
+     * (mf_solve_report.setups: 0 when a kept hierarchy served), and their
+     * set-up (assembly included) and iteration wall seconds. */
+    long solves, solve_setups;
+    double t_solve_setup, t_solve_iterate;
 } mf_parallel_stats;
 
 /* MPI must be initialised. On one rank *out is NULL (the serial run). */

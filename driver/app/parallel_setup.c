@@ -163,7 +163,10 @@ int mf_app_distribute(mf_app *app)
 
 /* One line a rank (at most 16 ranks; beyond that the smallest, mean and
  * largest): owned particles, the halo's share of the particles and the
- * bytes it sent a step, migration and rebalancing. */
+ * bytes it sent a step, migration and rebalancing; then the linear solves
+ * (every system the pressure modules solved: the PPE and the implicit
+ * viscosity's): solves and preconditioner set-ups a step, set-up and
+ * iteration time a step. */
 void mf_app_report_parallel(const mf_app *app)
 {
     mf_parallel *par = app->sim.par;
@@ -171,7 +174,7 @@ void mf_app_report_parallel(const mf_app *app)
         return;
     const mf_parallel_stats *st = mf_parallel_statistics(par);
     const double steps = app->run.steps > 0 ? (double)app->run.steps : 1.0;
-    enum { NV = 9 };
+    enum { NV = 13 };
     const double mine[NV] = {
         (double)app->sim.p->n_owned,
         st->owned_at_builds ? (double)st->halo_particles / (double)st->owned_at_builds : 0.0,
@@ -182,6 +185,10 @@ void mf_app_report_parallel(const mf_app *app)
         st->t_rebalance,
         (double)st->rebalances,
         st->t_halo_wait / steps,
+        (double)st->solves / steps,
+        (double)st->solve_setups / steps,
+        st->t_solve_setup / steps,
+        st->t_solve_iterate / steps,
     };
     const int size = mf_parallel_size(par);
     double *all = malloc((size_t)size * NV * sizeof *all);
@@ -202,6 +209,14 @@ void mf_app_report_parallel(const mf_app *app)
                           "    %4d %7.0f %11.3f %13.1f %14.1f %13.2f (%7.2f) %16.2f %12.2f\n",
                           r, v[0], v[1], v[2] / 1024, v[3], 1e3 * v[4], 1e3 * v[8],
                           1e3 * v[5], v[6]);
+        }
+        mf_log_printf(log, MF_LOG_QUIET,
+                      "    rank  solves/step  set-ups/step  set-up ms/step  iterations "
+                      "ms/step\n");
+        for (int r = 0; r < size && size <= 16; r++) {
+            const double *v = all + (size_t)r * NV;
+            mf_log_printf(log, MF_LOG_QUIET, "    %4d %12.2f %13.2f %15.2f %19.2f\n", r, v[9],
+                          v[10], 1e3 * v[11], 1e3 * v[12]);
         }
         if (size > 16)
             for (int k = 0; k < NV; k++) {

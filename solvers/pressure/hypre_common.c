@@ -51,6 +51,17 @@ int mf_hypre_agree(const char *who, int rc)
     return 0;
 }
 
+bool mf_hypre_all(bool local)
+{
+    int nprocs = 1;
+    MPI_Comm_size(MPI_COMM_WORLD, &nprocs);
+    if (nprocs == 1)
+        return local;
+    int mine = local, all = 0;
+    MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+    return all != 0;
+}
+
 int mf_hypre_check_pcg_settings(const char *who, double tolerance, long max_iter)
 {
     if (!(tolerance > 0.0 && tolerance <= 1.0))
@@ -243,6 +254,111 @@ static double residual_local(const void *ctx, const double *x, double *r)
     return sqrt(sum);
 }
 
+/* ---- slot space over the ranks ------------------------------------------- */
+
+/* Where hypre's rows are when the caller names them (mf_row_names): rank p's
+ * slots are hypre's rows [first_p, first_p + nslots_p), first_p the sum of
+ * the slots of the ranks before it, so each rank's hypre rows stay its own
+ * and keep their meaning while its particles do (a kept hierarchy's
+ * partition is then still the matrix's). A column names a global row, which
+ * may be another rank's: on several ranks every rank gathers the global
+ * slot of every global row (of_row, one int a row: O(nglobal) memory, as
+ * the residual's gathered x; good enough until many ranks). */
+typedef struct slot_space {
+    const mf_row_names *rows; /* NULL: row space */
+    int64_t first;            /* this rank's first hypre row (0 on one rank) */
+    int64_t total;            /* slots of all ranks */
+    int *of_row;              /* several ranks: hypre row of each global row */
+} slot_space;
+
+static void slot_space_free(slot_space *ss)
+{
+    free(ss->of_row);
+    memset(ss, 0, sizeof *ss);
+}
+
+/* The hypre row of the matrix's global row (column) c. */
+static HYPRE_BigInt slot_of_column(const slot_space *ss, const mf_csr *A, int64_t c)
+{
+    if (ss->of_row)
+        return (HYPRE_BigInt)ss->of_row[c];
+    return (HYPRE_BigInt)(ss->first + ss->rows->slot[c - A->row_offset]);
+}
+
+/* This rank's check of the names: one per row, distinct, in [0, nslots). */
+static int check_names(const char *who, const mf_csr *A, const mf_row_names *rows)
+{
+    if (rows->nslots < (int64_t)A->nrows || rows->nslots > HYPRE_INT_MAX ||
+        (A->nrows > 0 && rows->slot == NULL))
+        return MF_ERROR(MF_ERR_INPUT, "%s: %" PRId64 " slots for %zu rows", who, rows->nslots,
+                        A->nrows);
+    uint8_t *used = calloc((size_t)rows->nslots + 1, 1);
+    if (used == NULL)
+        return MF_ERROR(MF_ERR_MEMORY, "%s: out of memory (%" PRId64 " slots)", who,
+                        rows->nslots);
+    int rc = 0;
+    for (size_t i = 0; i < A->nrows && rc == 0; i++) {
+        const int64_t s = rows->slot[i];
+        if (s < 0 || s >= rows->nslots || used[s])
+            rc = MF_ERROR(MF_ERR_INPUT, "%s: row %zu names slot %" PRId64 ", %s", who, i, s,
+                          s < 0 || s >= rows->nslots ? "outside [0, nslots)"
+                                                     : "named by another row too");
+        else
+            used[s] = 1;
+    }
+    free(used);
+    return rc;
+}
+
+/* Collective: the slot space of this solve (rows NULL: row space). */
+static int slot_space_build(const char *who, const mf_csr *A, const mf_row_names *rows,
+                            const layout *lay, slot_space *ss)
+{
+    memset(ss, 0, sizeof *ss);
+    ss->rows = rows;
+    if (rows == NULL)
+        return 0;
+    MF_CALL(mf_hypre_agree(who, check_names(who, A, rows)));
+    ss->total = rows->nslots;
+    if (lay->nprocs == 1)
+        return 0;
+    int rc = 0;
+    int64_t *nslots = malloc((size_t)lay->nprocs * sizeof *nslots);
+    int *mine = malloc((A->nrows + 1) * sizeof *mine);
+    ss->of_row = malloc(((size_t)A->nglobal + 1) * sizeof *ss->of_row);
+    if (nslots == NULL || mine == NULL || ss->of_row == NULL)
+        rc = MF_ERROR(MF_ERR_MEMORY, "%s: out of memory for the slots of %" PRId64 " rows", who,
+                      A->nglobal);
+    MF_CALL_GOTO(rc, mf_hypre_agree(who, rc), fail);
+    MPI_Allgather(&rows->nslots, 1, MPI_INT64_T, nslots, 1, MPI_INT64_T, MPI_COMM_WORLD);
+    int rank = 0;
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    ss->total = 0;
+    for (int p = 0; p < lay->nprocs; p++) {
+        if (p == rank)
+            ss->first = ss->total;
+        ss->total += nslots[p];
+    }
+    /* Every rank computed the same total: the same decision everywhere. */
+    if (ss->total > HYPRE_BIGINT_MAX || ss->total > INT_MAX) {
+        rc = MF_ERROR(MF_ERR_INPUT, "%s: %" PRId64 " slots over the ranks exceed hypre's index",
+                      who, ss->total);
+        goto fail;
+    }
+    for (size_t i = 0; i < A->nrows; i++)
+        mine[i] = (int)(ss->first + rows->slot[i]);
+    MPI_Allgatherv(mine, (int)A->nrows, MPI_INT, ss->of_row, lay->counts, lay->displs, MPI_INT,
+                   MPI_COMM_WORLD);
+    free(nslots);
+    free(mine);
+    return 0;
+fail:
+    free(nslots);
+    free(mine);
+    slot_space_free(ss);
+    return rc;
+}
+
 /* ---- assembly ------------------------------------------------------------ */
 
 typedef struct hypre_system {
@@ -288,18 +404,20 @@ out:
  * exact diagonal-block / off-diagonal-block counts of every row, so it
  * allocates once and never needs its auxiliary (row-by-row) structure.
  *
- * With rows (slot space, one rank): hypre's row slot[r] holds row r, its
- * columns mapped through slot too, and every slot no row names holds the
- * decoupled row d x = 0 (d: the mean diagonal of the rows, so that a
- * smoother set up while the slot was one of them keeps its scale). The
- * list of hypre rows is the rows' slots in row order, then the free slots;
- * sys->rows[0, nrows) are where x comes back from. */
-static int assemble(const char *who, const mf_csr *A, const mf_row_names *rows, const double *b,
+ * With names (slot space, ss->rows; checked by slot_space_build): hypre's
+ * row first + slot[r] holds row r, its columns mapped the same way (through
+ * the ranks' gathered slots on several ranks), and every slot no row names
+ * holds the decoupled row d x = 0 (d: the mean diagonal of this rank's
+ * rows, so that a smoother set up while the slot was one of them keeps its
+ * scale). The list of hypre rows is the rows' slots in row order, then the
+ * free slots; sys->rows[0, nrows) are where x comes back from. */
+static int assemble(const char *who, const mf_csr *A, const slot_space *ss, const double *b,
                     const double *x, hypre_system *sys)
 {
+    const mf_row_names *rows = ss->rows;
     const HYPRE_Int nrows = (HYPRE_Int)A->nrows;
     const HYPRE_Int n = rows ? (HYPRE_Int)rows->nslots : nrows; /* hypre's local rows */
-    const HYPRE_BigInt ilower = rows ? 0 : (HYPRE_BigInt)A->row_offset;
+    const HYPRE_BigInt ilower = rows ? (HYPRE_BigInt)ss->first : (HYPRE_BigInt)A->row_offset;
     const HYPRE_BigInt iupper = ilower + n - 1; /* ilower - 1 on a rank with no rows */
     const size_t k0 = nrows > 0 ? A->rowptr[0] : 0;
     const size_t nnz_rows = nrows > 0 ? A->rowptr[nrows] - k0 : 0;
@@ -345,21 +463,22 @@ static int assemble(const char *who, const mf_csr *A, const mf_row_names *rows, 
         double dsum = 0;
         for (HYPRE_Int i = 0; i < nrows; i++) {
             const int64_t s = rows->slot[i];
-            if (s < 0 || s >= rows->nslots || used[s]) {
-                rc = MF_ERROR(MF_ERR_INPUT, "%s: row %d names slot %" PRId64 ", %s", who, (int)i,
-                              s, s < 0 || s >= rows->nslots ? "outside [0, nslots)"
-                                                            : "named by another row too");
-                goto out;
-            }
+            HYPRE_Int ndiag = 0, noffd = 0;
             used[s] = 1;
-            sys->rows[i] = (HYPRE_BigInt)s;
+            sys->rows[i] = ilower + (HYPRE_BigInt)s;
             ncols[i] = (HYPRE_Int)(A->rowptr[i + 1] - A->rowptr[i]);
-            diag_sizes[s] = ncols[i];
             for (size_t k = A->rowptr[i]; k < A->rowptr[i + 1]; k++) {
-                cols[k - k0] = (HYPRE_BigInt)rows->slot[A->col[k] - A->row_offset];
+                const HYPRE_BigInt c = slot_of_column(ss, A, A->col[k]);
+                cols[k - k0] = c;
+                if (c >= ilower && c <= iupper)
+                    ndiag++;
+                else
+                    noffd++;
                 if (A->col[k] == A->row_offset + i)
                     dsum += fabs(A->val[k]);
             }
+            diag_sizes[s] = ndiag;
+            offd_sizes[s] = noffd;
             bx[i] = b[i];
         }
         const double d = nrows > 0 && dsum > 0 ? dsum / nrows : 1.0;
@@ -367,15 +486,14 @@ static int assemble(const char *who, const mf_csr *A, const mf_row_names *rows, 
         size_t k = nnz_rows;
         for (HYPRE_Int s = 0; s < n; s++)
             if (!used[s]) {
-                sys->rows[next] = s;
+                sys->rows[next] = ilower + s;
                 ncols[next] = 1;
                 diag_sizes[s] = 1;
-                cols[k] = s;
+                offd_sizes[s] = 0;
+                cols[k] = ilower + s;
                 vals[k++ - nnz_rows] = d;
                 bx[next++] = 0.0;
             }
-        for (HYPRE_Int s = 0; s < n; s++)
-            offd_sizes[s] = 0;
     }
 
     MF_HYPRE_CALL(who, rc, out, HYPRE_IJMatrixCreate,
@@ -431,7 +549,10 @@ int mf_hypre_setup_cycle(const char *who, HYPRE_Solver amg, const mf_csr *A,
         HYPRE_BoomerAMGDestroy(amg);
         return MF_ERROR(MF_ERR_MEMORY, "%s: out of memory (%zu rows)", who, A->nrows);
     }
-    rc = assemble(who, A, rows, zero, zero, &sys);
+    const slot_space ss = {rows, 0, rows ? rows->nslots : 0, NULL}; /* one rank */
+    rc = rows ? check_names(who, A, rows) : 0;
+    if (rc == 0)
+        rc = assemble(who, A, &ss, zero, zero, &sys);
     if (rc == 0) {
         HYPRE_Int ierr = HYPRE_BoomerAMGSetup(amg, sys.parA, sys.parb, sys.parx);
         if (ierr != 0)
@@ -482,6 +603,7 @@ int mf_hypre_pcg_solve(const mf_hypre_pcg *pcg, const mf_csr *A, const double *b
     mf_solve_report unused;
     layout lay;
     hypre_system sys = {0};
+    slot_space ss = {0};
     mf_hypre_precond pc = {0};
     HYPRE_Solver solver = NULL;
     bool prepared = false, converged = false;
@@ -547,14 +669,10 @@ int mf_hypre_pcg_solve(const mf_hypre_pcg *pcg, const mf_csr *A, const double *b
     /* hypre's error flag is global and sticky: start clean so that a failure
      * left by someone else is not reported as ours. */
     HYPRE_ClearAllErrors();
-    /* Slot space on one rank only (the slots are a rank's own). */
-    const mf_row_names *rows = pcg->rows && lay.nprocs == 1 ? pcg->rows : NULL;
-    if (rows && (rows->nslots < (int64_t)A->nrows || rows->nslots > HYPRE_INT_MAX ||
-                 (A->nrows > 0 && rows->slot == NULL))) {
-        rc = MF_ERROR(MF_ERR_INPUT, "%s: %" PRId64 " slots for %zu rows", who, rows->nslots,
-                      A->nrows);
-        goto done;
-    }
+    /* Slot space when the rows are named: each rank's slots a block of
+     * hypre's rows (slot_space). */
+    const mf_row_names *rows = pcg->rows;
+    MF_CALL_GOTO(rc, slot_space_build(who, A, rows, &lay, &ss), done);
     if (own) {
         mf_amg_vcycle *cycle = NULL;
         MF_CALL_GOTO(rc, pcg->cycle_prepare(pcg->ctx, A, rows, &cycle), done);
@@ -577,7 +695,7 @@ int mf_hypre_pcg_solve(const mf_hypre_pcg *pcg, const mf_csr *A, const double *b
         }
         /* Not a hierarchy our cycle runs: hypre's PCG. */
     }
-    MF_CALL_GOTO(rc, assemble(who, A, rows, b, x, &sys), done);
+    MF_CALL_GOTO(rc, assemble(who, A, &ss, b, x, &sys), done);
     rc = pcg->precond_prepare(pcg->ctx, A, rows, &pc);
     prepared = rc == 0;
     MF_CALL_GOTO(rc, mf_hypre_agree(who, rc), done);
@@ -627,6 +745,7 @@ done:
     if (prepared && pcg->precond_release)
         pcg->precond_release(pcg->ctx, rep, rc == 0 && converged);
     system_free(&sys);
+    slot_space_free(&ss);
     layout_free(&lay);
     free(r);
     if (rc == 0 && !converged)

@@ -30,7 +30,13 @@
  *    the iterations of the hierarchy's first solve (at least two more).
  *    Without the rebuild a kept hierarchy ages: on the 2-D bench dam break
  *    the iterations grow from 5 to 8 over 25 steps and to 49 over 1000
- *    (docs/validation-and-performance.md).
+ *    (docs/validation-and-performance.md). On several ranks each rank's
+ *    slots are a block of hypre's rows (hypre_common.c), and the decision
+ *    is one for all (may_keep): a rank whose particles changed (migration,
+ *    reordering) makes every rank set a new hierarchy up, since hypre's
+ *    set-up is collective and the hierarchy's row partition is the ranks'
+ *    slot counts. The solve is then hypre's PCG (our V-cycle runs on one
+ *    rank only).
  *  - reuseSetup > 0 keeps the hierarchy for that many further solves as
  *    long as the matrix size and sparsity pattern do not change (the
  *    implicit viscosity: one matrix, a solve per velocity component).
@@ -56,6 +62,7 @@ typedef struct pcg_boomeramg {
     HYPRE_Solver amg;
     mf_amg_vcycle *cycle;
     bool reused;       /* the current solve reuses amg */
+    long setups;       /* hierarchies set up so far (mf_solve_report.setups) */
     /* reuseSetup: the pattern amg was set up with, the solves it may serve. */
     uint64_t pattern;
     long reuses_left;
@@ -220,8 +227,9 @@ static HYPRE_Int keep_hierarchy(HYPRE_Solver amg, HYPRE_ParCSRMatrix A, HYPRE_Pa
 }
 
 /* reuseHierarchy: whether the kept hierarchy may serve this solve in slot
- * space (same slots, same epoch, its iterations not grown too far). */
-static bool may_keep(const pcg_boomeramg *d, const mf_row_names *rows)
+ * space (same slots, same epoch, its iterations not grown too far) on this
+ * rank. */
+static bool may_keep_here(const pcg_boomeramg *d, const mf_row_names *rows)
 {
     if (!(d->amg || d->cycle) || !d->slot_space || rows->nslots != d->nslots ||
         rows->epoch != d->epoch)
@@ -231,6 +239,16 @@ static bool may_keep(const pcg_boomeramg *d, const mf_row_names *rows)
         return true;
     const double bound = fmax(d->s.rebuild_ratio * first, first + 2.0);
     return d->last_iterations <= bound;
+}
+
+/* Collective: ... on every rank (hypre's set-up is collective, and a
+ * hierarchy's row partition is every rank's slots: one rank whose particles
+ * changed, by migration or reordering, needs a new one for all). The
+ * iteration counts are the same on every rank; the slots and epochs are each
+ * rank's own. */
+static bool may_keep(const pcg_boomeramg *d, const mf_row_names *rows)
+{
+    return mf_hypre_all(may_keep_here(d, rows));
 }
 
 static int precond_prepare(void *ctx, const mf_csr *A, const mf_row_names *rows, mf_hypre_precond *pc)
@@ -247,6 +265,7 @@ static int precond_prepare(void *ctx, const mf_csr *A, const mf_row_names *rows,
         }
         discard_hierarchy(d);
         MF_CALL(mf_boomeramg_create(&d->s, &d->amg));
+        d->setups++;
         d->slot_space = true;
         d->nslots = rows->nslots;
         d->epoch = rows->epoch;
@@ -269,6 +288,7 @@ static int precond_prepare(void *ctx, const mf_csr *A, const mf_row_names *rows,
         d->pattern = pattern;
     }
     MF_CALL(mf_boomeramg_create(&d->s, &d->amg));
+    d->setups++;
     d->reuses_left = d->s.reuse_setup;
     *pc = (mf_hypre_precond){HYPRE_BoomerAMGSolve, HYPRE_BoomerAMGSetup, d->amg};
     return 0;
@@ -309,6 +329,7 @@ static int cycle_prepare(void *ctx, const mf_csr *A, const mf_row_names *rows,
     HYPRE_Solver amg = NULL;
     MF_CALL(mf_boomeramg_create(&d->s, &amg));
     const mf_row_names *slots = rows && d->s.reuse_hierarchy ? rows : NULL;
+    d->setups++;
     MF_CALL(mf_hypre_setup_cycle(module_name, amg, A, slots, &d->cycle));
     if (d->cycle == NULL)
         return 0;
@@ -358,8 +379,11 @@ static int solve_impl(pcg_boomeramg *d, const mf_csr *A, const mf_row_names *row
     if (rep == NULL)
         rep = &local;
     d->reused = false;
+    const long setups_before = d->setups;
     if ((d->amg == NULL && d->cycle == NULL) || A == NULL || x == NULL) {
-        MF_CALL(mf_hypre_pcg_solve(&pcg, A, b, x, rep));
+        int rc = mf_hypre_pcg_solve(&pcg, A, b, x, rep);
+        rep->setups = (int)(d->setups - setups_before);
+        MF_CALL(rc);
         return 0;
     }
 
@@ -381,6 +405,7 @@ static int solve_impl(pcg_boomeramg *d, const mf_csr *A, const mf_row_names *row
         rep->solve_seconds += first.solve_seconds;
     }
     free(x0);
+    rep->setups = (int)(d->setups - setups_before);
     if (rc != 0)
         return mf_error_trace(rc, __FILE__, __LINE__, __func__);
     return 0;

@@ -7,8 +7,9 @@
  *
  * Both take the matrix as this rank's rows of an mf_csr, copy it into hypre
  * IJ/ParCSR objects (rebuilt on every solve: particles move, so the pattern
- * changes every step; in slot space when the caller names the rows, see
- * mf_hypre_pcg.rows), solve, and report iterations and the true relative
+ * changes every step; in slot space when the caller names the rows, on one
+ * rank or several, see mf_hypre_pcg.rows), solve, and report iterations,
+ * set-ups and the true relative
  * residuals ||b - A x|| / ||b|| computed from the caller's CSR. PCG_BoomerAMG
  * may keep its AMG hierarchy across solves (pcg_boomeramg.c).
  *
@@ -74,12 +75,13 @@ typedef struct mf_hypre_pcg {
     const char *name; /* module name, for messages */
     double tolerance;
     long max_iter;
-    /* Optional (NULL: row space): the rows' names. On one rank the system
-     * is then assembled in slot space: slot[r] holds row r, and a slot no
-     * row names is a decoupled row d x = 0 (d the mean diagonal, b = x = 0),
-     * so that a preconditioner set up for one solve can serve a later one
-     * whose rows differ (a free-surface particle is a Dirichlet value in one
-     * step and an unknown in the next). */
+    /* Optional (NULL: row space): the rows' names. The system is then
+     * assembled in slot space: slot[r] of this rank holds row r (rank p's
+     * slots are hypre's rows from the sum of the slots of ranks before p),
+     * and a slot no row names is a decoupled row d x = 0 (d the mean
+     * diagonal, b = x = 0), so that a preconditioner set up for one solve
+     * can serve a later one whose rows differ (a free-surface particle is a
+     * Dirichlet value in one step and an unknown in the next). */
     const mf_row_names *rows;
     /* Fill *pc once the matrix is known (called after the cheap exits, so
      * not at all for b = 0 or an initial guess that already converged).
@@ -124,6 +126,9 @@ int mf_hypre_check_pcg_settings(const char *who, double tolerance, long max_iter
  * message already recorded) or MF_ERR_INPUT saying another rank failed.
  * Keeps all ranks on the same path, so none waits in a collective call. */
 int mf_hypre_agree(const char *who, int rc);
+
+/* Collective: whether local holds on every rank (one decision for all). */
+bool mf_hypre_all(bool local);
 
 /* Record a failed hypre call as MF_ERR_LIBRARY naming the function, and
  * clear hypre's error flag (global and sticky: it would make every later
