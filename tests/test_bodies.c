@@ -21,7 +21,13 @@
  *   snapshot   the last snapshot holds the body's state (/RigidBodies/body):
  *              its Velocity is the CSV's at that time (to the CSV's digits);
  *   at rest    the same body with the blob at rest stays at rest (no force
- *              from nothing): |v_b| below 1e-6 m/s.
+ *              from nothing): |v_b| below 1e-6 m/s;
+ *   restart    the momentum case stopped at t = 0.04 s and restarted from
+ *              that snapshot (-latestTime) ends as the straight run does, bit
+ *              for bit: every particle's position and velocity, the body's
+ *              state in the last snapshot (/RigidBodies/body), and the text of
+ *              bodyState.csv (the rows up to the restart kept, the rest
+ *              appended).
  *
  * argv[1]: mpsflow. */
 #include <math.h>
@@ -253,6 +259,103 @@ static void check_rest(const char *exe)
     tc_case_destroy(&c);
 }
 
+/* The whole text of a file (NULL if unreadable); free it. */
+static char *slurp(const char *dir, const char *rel)
+{
+    char path[1024];
+    snprintf(path, sizeof path, "%s/%s", dir, rel);
+    return tc_read_text(path);
+}
+
+/* The particles and the body's attributes of the last snapshots of x and y
+ * are identical; returns the number of differences. */
+static int compare_ends(const tc_case *x, const tc_case *y)
+{
+    tc_snapshots sx, sy;
+    if (tc_snapshots_list(x->dir, &sx) != 0)
+        return 1;
+    if (tc_snapshots_list(y->dir, &sy) != 0) {
+        tc_snapshots_free(&sx);
+        return 1;
+    }
+    int diff = 0;
+    mf_sim a, b;
+    mf_hdf5_header ha, hb;
+    if (sx.n == 0 || sy.n == 0 || tc_snapshot_load(x->dir, sx.index[sx.n - 1], &a, &ha) != 0) {
+        diff++;
+    } else {
+        if (tc_snapshot_load(y->dir, sy.index[sy.n - 1], &b, &hb) != 0) {
+            diff++;
+        } else {
+            size_t pos = 0, vel = 0;
+            if (a.p->n != b.p->n || ha.time != hb.time || ha.step != hb.step) {
+                diff++;
+            } else {
+                for (size_t i = 0; i < a.p->n; i++) {
+                    pos += memcmp(&a.p->pos[3 * i], &b.p->pos[3 * i], 3 * sizeof(double)) != 0;
+                    vel += memcmp(&a.p->vel[3 * i], &b.p->vel[3 * i], 3 * sizeof(double)) != 0;
+                }
+            }
+            printf("restart: t = %g, step %ld against %ld: %zu positions and %zu velocities "
+                   "differ of %zu\n", hb.time, ha.step, hb.step, pos, vel, a.p->n);
+            diff += pos > 0 || vel > 0;
+            tc_sim_free(&b);
+        }
+        tc_sim_free(&a);
+    }
+    static const char *const names[] = {"Centre", "Rotation", "Velocity", "AngularMomentum",
+                                        "Impulse"};
+    static const int counts[] = {3, 9, 3, 3, 3};
+    for (size_t k = 0; diff == 0 && k < sizeof names / sizeof names[0]; k++) {
+        char pa[1024], pb[1024];
+        tc_snapshot_path(x->dir, sx.index[sx.n - 1], pa, sizeof pa);
+        tc_snapshot_path(y->dir, sy.index[sy.n - 1], pb, sizeof pb);
+        double va[9], vb[9];
+        if (body_attribute(pa, "body", names[k], va) != 0 ||
+            body_attribute(pb, "body", names[k], vb) != 0 ||
+            memcmp(va, vb, (size_t)counts[k] * sizeof(double)) != 0) {
+            printf("restart: /RigidBodies/body %s differs\n", names[k]);
+            diff++;
+        }
+    }
+    tc_snapshots_free(&sx);
+    tc_snapshots_free(&sy);
+    return diff;
+}
+
+static void check_restart(const char *exe)
+{
+    const double U = 0.05;
+    char geo[2048];
+    geometry(geo, sizeof geo, U);
+    static const char *const ctl =
+        "endTime 0.1;\ndeltaT 1e-4;\nadjustTimeStep yes;\nmaxCo 0.2;\nmaxDeltaT 1e-3;\n"
+        "writeControl adjustableRunTime;\nwriteInterval 0.02;\n";
+    tc_case whole, split;
+    CHECK_OK(tc_case_from_strings(&whole, exe, "bodies-whole", ctl, solver, fluids, geo));
+    CHECK_OK(tc_case_from_strings(&split, exe, "bodies-split", ctl, solver, fluids, geo));
+    bool ok = run(&whole, "restart: the straight run");
+    int s1 = tc_case_run(&split, NULL, (const char *const[]){"-endTime", "0.04", NULL});
+    int s2 = s1 == 0 ? tc_case_run(&split, NULL, (const char *const[]){"-latestTime", NULL}) : -1;
+    CHECK_MSG(s1 == 0 && s2 == 0, "restart: the split run exited with %d, %d", s1, s2);
+    if (s1 != 0 || s2 != 0)
+        tc_case_log_tail(&split, 20);
+    CHECK_MSG(tc_case_log_contains(&split, "Restarting from time 0.04"),
+              "restart: the second run did not restart at t = 0.04");
+    if (ok && s1 == 0 && s2 == 0) {
+        CHECK_MSG(compare_ends(&whole, &split) == 0, "restart: the ends differ");
+        char *a = slurp(whole.dir, "postProcessing/body/bodyState.csv");
+        char *b = slurp(split.dir, "postProcessing/body/bodyState.csv");
+        CHECK_MSG(a && b && strcmp(a, b) == 0,
+                  "restart: bodyState.csv differs from the straight run's (%zu against %zu "
+                  "bytes)", a ? strlen(a) : 0, b ? strlen(b) : 0);
+        free(a);
+        free(b);
+    }
+    tc_case_destroy(&whole);
+    tc_case_destroy(&split);
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -261,5 +364,6 @@ int main(int argc, char **argv)
     }
     check_momentum(argv[1]);
     check_rest(argv[1]);
+    check_restart(argv[1]);
     return mf_test_summary("bodies");
 }

@@ -67,8 +67,9 @@ int mf_body_surface(const mf_wall *w, const double x[3], double l0, double out_a
 int mf_bodies_accept(mf_walls *ws, double t, double dt);
 
 /* Open postProcessing/<body>/bodyState.csv under post_dir (created) for
- * each body and write the row of the initial state at time t. */
-int mf_bodies_open_output(mf_walls *ws, const char *post_dir, double t);
+ * each body and write the row of the initial state at time t; on a restart
+ * (from a snapshot at t) keep the file's rows up to t and append. */
+int mf_bodies_open_output(mf_walls *ws, const char *post_dir, double t, bool restart);
 
 /* The body's mass and its linear and angular momentum (angular about its
  * centre of mass), committed, and the pending impulses J^n, H^n. */
@@ -79,5 +80,10 @@ typedef struct mf_body_momentum {
     double impulse[3], angular_impulse[3];
 } mf_body_momentum;
 void mf_body_get(const mf_wall *w, mf_body_momentum *out);
+
+/* A restart: the committed state (and pending impulses) from a snapshot's
+ * /RigidBodies/<name> (mf_body_get's fields; mass checked against the
+ * case's, where names the snapshot group for the message). */
+int mf_body_set(mf_wall *w, const mf_body_momentum *s, const char *where);
 
 #endif

@@ -341,7 +341,41 @@ int mf_bodies_accept(mf_walls *ws, double t, double dt)
     return 0;
 }
 
-int mf_bodies_open_output(mf_walls *ws, const char *post_dir, double t)
+/* A restart at time t: the rows of path up to t (the previous run's, which
+ * may have gone on past its last snapshot) are kept and the file is opened
+ * to append; false when there is no such file. */
+static int reopen_at(mf_body *b, const char *path, double t, bool *kept)
+{
+    *kept = false;
+    FILE *in = fopen(path, "r");
+    if (!in)
+        return 0;
+    char tmp[4500];
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    FILE *out = fopen(tmp, "w");
+    if (!out) {
+        fclose(in);
+        return MF_ERROR(MF_ERR_IO, "cannot write %s: %s", tmp, strerror(errno));
+    }
+    char line[4096];
+    while (fgets(line, sizeof line, in)) {
+        char *end;
+        const double row_t = strtod(line, &end);
+        /* comments and the column names stay; rows up to t (%.9g of it) */
+        if (end == line || row_t <= t + 1e-9 * fmax(fabs(t), 1e-300))
+            fputs(line, out);
+    }
+    fclose(in);
+    if (fclose(out) != 0 || rename(tmp, path) != 0)
+        return MF_ERROR(MF_ERR_IO, "cannot write %s: %s", path, strerror(errno));
+    b->csv = fopen(path, "a");
+    if (!b->csv)
+        return MF_ERROR(MF_ERR_IO, "cannot write %s: %s", path, strerror(errno));
+    *kept = true;
+    return 0;
+}
+
+int mf_bodies_open_output(mf_walls *ws, const char *post_dir, double t, bool restart)
 {
     if (mf_bodies_count(ws) == 0)
         return 0;
@@ -357,6 +391,12 @@ int mf_bodies_open_output(mf_walls *ws, const char *post_dir, double t)
         snprintf(path, sizeof path, "%s/%s/bodyState.csv", post_dir, w->name);
         if (b->csv)
             fclose(b->csv);
+        b->csv = NULL;
+        bool kept = false;
+        if (restart)
+            MF_CALL(reopen_at(b, path, t, &kept));
+        if (kept)
+            continue;
         b->csv = fopen(path, "w");
         if (!b->csv)
             return MF_ERROR(MF_ERR_IO, "cannot write %s: %s", path, strerror(errno));
@@ -386,6 +426,34 @@ void mf_body_get(const mf_wall *w, mf_body_momentum *out)
         out->impulse[c] = b->J[c];
         out->angular_impulse[c] = b->H[c];
     }
+}
+
+int mf_body_set(mf_wall *w, const mf_body_momentum *s, const char *where)
+{
+    mf_body *b = w->body;
+    if (!b)
+        return MF_ERROR(MF_ERR_INTERNAL, "%s: '%s' is not a rigid body", where, w->name);
+    if (!(fabs(s->mass - b->mass) <= 1e-12 * b->mass))
+        return MF_ERROR(MF_ERR_INPUT, "cannot restart: %s holds rigid body '%s' of mass %.9g, "
+                        "the case's (constant/geometry) is %.9g: start a new run", where,
+                        w->name, s->mass, b->mass);
+    memcpy(b->R, s->rotation, sizeof b->R);
+    for (int c = 0; c < 3; c++) {
+        b->x[c] = s->centre[c];
+        b->v[c] = s->velocity[c];
+        b->w[c] = s->omega[c];
+        b->L[c] = s->angular[c];
+        b->J[c] = s->impulse[c];
+        b->H[c] = s->angular_impulse[c];
+    }
+    memcpy(b->xt, b->x, sizeof b->x);
+    memcpy(b->vt, b->v, sizeof b->v);
+    memcpy(b->Rt, b->R, sizeof b->R);
+    memcpy(b->Lt, b->L, sizeof b->L);
+    memcpy(b->wt, b->w, sizeof b->w);
+    static const double zero[3] = {0, 0, 0};
+    to_state(w, b->x, b->R, b->v, b->w, zero, zero);
+    return 0;
 }
 
 /* Depth of body point xb below each face of a box (xmin xmax ymin ...). */
