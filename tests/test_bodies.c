@@ -27,7 +27,16 @@
  *              for bit: every particle's position and velocity, the body's
  *              state in the last snapshot (/RigidBodies/body), and the text of
  *              bodyState.csv (the rows up to the restart kept, the rest
- *              appended).
+ *              appended);
+ *   contact    two boxes (0.1 x 0.05 m, density 500) dropped in a dry tank,
+ *              the upper 0.1 m above the lower and 0.02 m to the side: the
+ *              lower lands on the floor, the upper on it (body_contact.c):
+ *              at t = 0.5 s their centres are within l0/4 of resting (y =
+ *              0.025 and 0.075 m: bottom on the floor, bottom on the lower's
+ *              top), moving up or down at less than 0.05 m/s, turned by less
+ *              than 2 degrees (without friction they may slide sideways). Without
+ *              contact both fall through the floor (a box falls 0.1 m in
+ *              0.14 s).
  *
  * argv[1]: mpsflow. */
 #include <math.h>
@@ -356,6 +365,78 @@ static void check_restart(const char *exe)
     tc_case_destroy(&split);
 }
 
+/* The last row (time, x, y, |vy|, qz) of postProcessing/<body>/bodyState.csv. */
+static int last_row(const char *dir, const char *body, double row[5])
+{
+    char path[1024];
+    snprintf(path, sizeof path, "%s/postProcessing/%s/bodyState.csv", dir, body);
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return -1;
+    char line[4096];
+    int got = -1;
+    while (fgets(line, sizeof line, f)) {
+        double c[20];
+        int k = 0;
+        for (char *s = line, *e; k < 20; k++, s = e + 1) {
+            c[k] = strtod(s, &e);
+            if (e == s || (*e != ',' && k < 19))
+                break;
+        }
+        if (k < 19)
+            continue;
+        row[0] = c[0];
+        row[1] = c[1];
+        row[2] = c[2];
+        row[3] = fabs(c[9]); /* vertical: without friction the stack may slide */
+        row[4] = c[7];
+        got = 0;
+    }
+    fclose(f);
+    return got;
+}
+
+static void check_contact(const char *exe)
+{
+    static const char *const ctl =
+        "endTime 0.5;\ndeltaT 1e-4;\nadjustTimeStep yes;\nmaxCo 0.2;\nmaxDeltaT 1e-3;\n"
+        "writeControl adjustableRunTime;\nwriteInterval 0.1;\n";
+    static const char *const slv = "solver MPS;\n"
+                                   "pressure { solver PCG_BoomerAMG; tolerance 1e-8; }\n"
+                                   "forces { gravity { g (0 -9.81 0); } }\n";
+    /* a puddle in a corner: a case needs fluid */
+    static const char *const geo =
+        "dimension 2;\nparticleSpacing 0.01;\n"
+        "fluidBlocks { water { type box; min (0 0 0); max (0.1 0.05 0); fluid water; } }\n"
+        "walls { tank { type box; min (0 0 0); max (0.6 0.5 0); open (ymax); } }\n"
+        "obstacles {\n"
+        " lower { type box; min (0.3 0.1 0); max (0.4 0.15 0);\n"
+        "  motion { type rigid; density 500; } }\n"
+        " upper { type box; min (0.32 0.25 0); max (0.42 0.3 0);\n"
+        "  motion { type rigid; density 500; } } }\n";
+    tc_case c;
+    CHECK_OK(tc_case_from_strings(&c, exe, "bodies-contact", ctl, slv, fluids, geo));
+    if (run(&c, "contact")) {
+        double lo[5], up[5];
+        const bool ok = last_row(c.dir, "lower", lo) == 0 && last_row(c.dir, "upper", up) == 0;
+        CHECK_MSG(ok, "contact: no bodyState.csv rows");
+        if (ok) {
+            /* qz = sin(angle/2) */
+            const double alo = 2 * asin(fabs(lo[4])) * 180 / M_PI,
+                         aup = 2 * asin(fabs(up[4])) * 180 / M_PI;
+            printf("contact: t = %g: lower at y = %.5f m (%.3g m/s, %.3g deg), upper at y = "
+                   "%.5f m (%.3g m/s, %.3g deg), %.4f m to the side\n", lo[0], lo[2], lo[3], alo,
+                   up[2], up[3], aup, up[1] - lo[1]);
+            CHECK(fabs(lo[0] - 0.5) < 1e-9);
+            CHECK(fabs(lo[2] - 0.025) < 0.25 * L0);
+            CHECK(fabs(up[2] - 0.075) < 0.25 * L0);
+            CHECK(lo[3] < 0.05 && up[3] < 0.05);
+            CHECK(alo < 2 && aup < 2);
+        }
+    }
+    tc_case_destroy(&c);
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -365,5 +446,6 @@ int main(int argc, char **argv)
     check_momentum(argv[1]);
     check_rest(argv[1]);
     check_restart(argv[1]);
+    check_contact(argv[1]);
     return mf_test_summary("bodies");
 }

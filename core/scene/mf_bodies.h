@@ -22,6 +22,14 @@
  * body is then where it is at the end of the step the fluid takes
  * (mf_walls_advance moves its particles there with its velocity there).
  *
+ * Contact: where a body's surface would overlap a wall, an obstacle or
+ * another body at the trial state, the approach at the deepest point is
+ * stopped by an impulse (restitution e: -(1+e) v_n over the pair's
+ * effective mass, the collision of two rigid bodies without friction,
+ * e.g. Baraff 1997, "An introduction to physically based modeling: rigid
+ * body simulation II", eq. 8-18) and the overlap is removed from the trial
+ * position (p holds the particles where the committed state has them).
+ *
  * A retry of a step computes the trial state again from the committed state
  * at t^n: nothing to restore. A step is committed by mf_bodies_accept, which
  * writes the row of postProcessing/<body>/bodyState.csv. */
@@ -42,7 +50,7 @@ size_t mf_bodies_count(const mf_walls *ws);
 /* The states of the bodies at t_from (committed) or at t_to (the trial
  * state of a step of t_to - t_from from there): mf_walls_advance's. */
 void mf_bodies_set_committed(mf_walls *ws);
-void mf_bodies_set_trial(mf_walls *ws, double dt);
+int mf_bodies_set_trial(mf_walls *ws, const mf_particles *p, double dt);
 
 /* The solver's part: w->force and w->torque of every body set to zero (the
  * start of an attempt), then a force f on the body at world point x. */
