@@ -36,9 +36,16 @@
  *              top), moving up or down at less than 0.05 m/s, turned by less
  *              than 2 degrees (without friction they may slide sideways). Without
  *              contact both fall through the floor (a box falls 0.1 m in
- *              0.14 s).
+ *              0.14 s);
+ *   waterEntry the tutorial at l0 = 0.011 m (10 particles across D = 0.11 m),
+ *              then `mpsflow validate`: its momentum-theory curves at
+ *              t = 0.03 s are an independent RK4 of the same equation's
+ *              (von Karman 0.0550 m, Wagner 0.0494 m, to 1e-4 m); the
+ *              penetration there lies between them widened by l0/2 (the
+ *              body's surface is l0/2 from its particles); the RMS error
+ *              is below l0/2 of D.
  *
- * argv[1]: mpsflow. */
+ * argv[1]: mpsflow; argv[2]: tutorials/waterEntry. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -437,15 +444,58 @@ static void check_contact(const char *exe)
     tc_case_destroy(&c);
 }
 
+static void check_water_entry(const char *exe, const char *tutorial)
+{
+    const double l0 = 0.011, D = 0.11;
+    tc_case c;
+    CHECK_OK(tc_case_from_dir(&c, exe, "bodies-waterEntry", tutorial));
+    int status = tc_case_run(&c, NULL, (const char *const[]){"-l0", "0.011", NULL});
+    CHECK_MSG(status == 0, "waterEntry: mpsflow exited with %d", status);
+    if (status == 0)
+        status = tc_case_run(&c, "validate", NULL);
+    CHECK_MSG(status == 0, "waterEntry: validate exited with %d", status);
+    if (status != 0) {
+        tc_case_log_tail(&c, 20);
+        tc_case_destroy(&c);
+        return;
+    }
+    char path[1024];
+    snprintf(path, sizeof path, "%s/validation/result.csv", c.dir);
+    FILE *f = fopen(path, "r");
+    CHECK_MSG(f != NULL, "waterEntry: no %s", path);
+    double last[4] = {NAN, NAN, NAN, NAN}, sum = 0;
+    size_t rows = 0;
+    char line[1024];
+    while (f && fgets(line, sizeof line, f)) {
+        double v[4];
+        if (line[0] == '#' || sscanf(line, "%lf,%lf,%lf,%lf", &v[0], &v[1], &v[2], &v[3]) != 4)
+            continue;
+        if (rows++ > 0) /* the first row is t = 0, h = 0 */
+            sum += (v[1] - v[2]) * (v[1] - v[2]) / (D * D);
+        memcpy(last, v, sizeof v);
+    }
+    if (f)
+        fclose(f);
+    const double rms = rows > 1 ? sqrt(sum / (double)(rows - 1)) : NAN;
+    printf("waterEntry: t = %g: h = %.5f m, von Karman %.5f m, Wagner %.5f m; RMS (h - "
+           "h_vK)/D = %.4g over %zu rows\n", last[0], last[1], last[2], last[3], rms, rows);
+    CHECK(fabs(last[0] - 0.03) < 1e-6);
+    CHECK(fabs(last[2] - 0.0550) < 1e-4 && fabs(last[3] - 0.0494) < 1e-4);
+    CHECK(last[1] > last[3] - 0.5 * l0 && last[1] < last[2] + 0.5 * l0);
+    CHECK(rms < 0.5 * l0 / D);
+    tc_case_destroy(&c);
+}
+
 int main(int argc, char **argv)
 {
-    if (argc < 2) {
-        fprintf(stderr, "usage: test_bodies MPSFLOW\n");
+    if (argc < 3) {
+        fprintf(stderr, "usage: test_bodies MPSFLOW TUTORIALS/waterEntry\n");
         return 2;
     }
     check_momentum(argv[1]);
     check_rest(argv[1]);
     check_restart(argv[1]);
     check_contact(argv[1]);
+    check_water_entry(argv[1], argv[2]);
     return mf_test_summary("bodies");
 }
