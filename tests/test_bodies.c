@@ -92,6 +92,18 @@ typedef struct track {
     double mass;
 } track;
 
+/* The 20 numbers of a row of bodyState.csv (false: a comment or header). */
+static bool csv_row(char *line, double c[20])
+{
+    int k = 0;
+    for (char *s = line, *e; k < 20; k++, s = e + 1) {
+        c[k] = strtod(s, &e);
+        if (e == s || (*e != ',' && k < 19))
+            break;
+    }
+    return k >= 19;
+}
+
 static int read_track(const char *dir, track *tr)
 {
     char path[1024];
@@ -110,13 +122,7 @@ static int read_track(const char *dir, track *tr)
             continue;
         }
         double c[20];
-        int k = 0;
-        for (char *s = line, *e; k < 20; k++, s = e + 1) {
-            c[k] = strtod(s, &e);
-            if (e == s || (*e != ',' && k < 19))
-                break;
-        }
-        if (k < 19)
+        if (!csv_row(line, c))
             continue;
         if (tr->n == cap) {
             cap = cap ? 2 * cap : 256;
@@ -384,13 +390,7 @@ static int last_row(const char *dir, const char *body, double row[5])
     int got = -1;
     while (fgets(line, sizeof line, f)) {
         double c[20];
-        int k = 0;
-        for (char *s = line, *e; k < 20; k++, s = e + 1) {
-            c[k] = strtod(s, &e);
-            if (e == s || (*e != ',' && k < 19))
-                break;
-        }
-        if (k < 19)
+        if (!csv_row(line, c))
             continue;
         row[0] = c[0];
         row[1] = c[1];
