@@ -345,7 +345,7 @@ EXPECTED.update({
     'unknown command':
         "mpsflow: unknown command 'modulse' (did you mean 'modules'?)",
     'unknown module':
-        "--> mpsflow FATAL ERROR: no module or case dictionary named 'MSP' (did you mean 'MPS'?); known: MPS, multiFluid, MAFL, PCG_BoomerAMG, PCG_diagonal, upwind, QUICK, gravity, surfaceTension, drag, attraction, velocityRegion, pathFollow, surface, levelSet, blobby, hdf5, surgeFront, hydrostaticPressure, scalarAdvection, volumeFlux, laplacePressure, oscillationPeriod, layering, rayleighTaylor, fluidSurgeFront, poiseuille, couette, sloshingPeriod, containment, restingTank, targetFraction, floatingDraft, controlDict, watch, geometry, fluids, validation, compareDict, stabilityDict, decomposeParDict",
+        "--> mpsflow FATAL ERROR: no module or case dictionary named 'MSP' (did you mean 'MPS'?); known: MPS, multiFluid, MAFL, PCG_BoomerAMG, PCG_diagonal, upwind, QUICK, gravity, surfaceTension, drag, attraction, velocityRegion, pathFollow, surface, levelSet, blobby, hdf5, surgeFront, hydrostaticPressure, scalarAdvection, volumeFlux, laplacePressure, oscillationPeriod, layering, rayleighTaylor, fluidSurgeFront, poiseuille, couette, sloshingPeriod, containment, restingTank, targetFraction, floatingDraft, waterEntryDepth, controlDict, watch, geometry, fluids, validation, compareDict, stabilityDict, decomposeParDict",
     'misspelt key':
         "--> mpsflow FATAL ERROR: {case}/system/controlDict:15:1: unknown key 'endTme' in '(top level)' (did you mean 'endTime'?); valid keys: application, startTime, endTime, deltaT, adjustTimeStep, maxCo, maxDi, maxDeltaT, minDeltaT, writeControl, writeInterval, writer, startFrom, maxRetries, maxMemory, stopAt, runTimeModifiable, purgeWrite, FoamFile, libs, functions, watch, writerCoeffs",
     'wrong type':
@@ -513,7 +513,7 @@ EXPECTED.update({
     'validate without metric':
         "--> mpsflow FATAL ERROR: cannot open dictionary file '{case}/validation/metric' (No such file or directory)",
     'unknown metric':
-        "--> mpsflow FATAL ERROR: {case}/validation/metric:14:1: unknown metric module 'surge'; valid metric modules: surgeFront, hydrostaticPressure, scalarAdvection, volumeFlux, laplacePressure, oscillationPeriod, layering, rayleighTaylor, fluidSurgeFront, poiseuille, couette, sloshingPeriod, containment, restingTank, targetFraction, floatingDraft",
+        "--> mpsflow FATAL ERROR: {case}/validation/metric:14:1: unknown metric module 'surge'; valid metric modules: surgeFront, hydrostaticPressure, scalarAdvection, volumeFlux, laplacePressure, oscillationPeriod, layering, rayleighTaylor, fluidSurgeFront, poiseuille, couette, sloshingPeriod, containment, restingTank, targetFraction, floatingDraft, waterEntryDepth",
     'restart without snapshots':
         '--> mpsflow FATAL ERROR: no snapshot to restart from in {case}/output (run without -latestTime first)',
     'compareDict unknown key':

@@ -22,6 +22,14 @@
  * body is then where it is at the end of the step the fluid takes
  * (mf_walls_advance moves its particles there with its velocity there).
  *
+ * Contact: where a body's surface would overlap a wall, an obstacle or
+ * another body at the trial state, the approach at the deepest point is
+ * stopped by an impulse (restitution e: -(1+e) v_n over the pair's
+ * effective mass, the collision of two rigid bodies without friction,
+ * e.g. Baraff 1997, "An introduction to physically based modeling: rigid
+ * body simulation II", eq. 8-18) and the overlap is removed from the trial
+ * position (p holds the particles where the committed state has them).
+ *
  * A retry of a step computes the trial state again from the committed state
  * at t^n: nothing to restore. A step is committed by mf_bodies_accept, which
  * writes the row of postProcessing/<body>/bodyState.csv. */
@@ -42,7 +50,7 @@ size_t mf_bodies_count(const mf_walls *ws);
 /* The states of the bodies at t_from (committed) or at t_to (the trial
  * state of a step of t_to - t_from from there): mf_walls_advance's. */
 void mf_bodies_set_committed(mf_walls *ws);
-void mf_bodies_set_trial(mf_walls *ws, double dt);
+int mf_bodies_set_trial(mf_walls *ws, const mf_particles *p, double dt);
 
 /* The solver's part: w->force and w->torque of every body set to zero (the
  * start of an attempt), then a force f on the body at world point x. */
@@ -67,8 +75,9 @@ int mf_body_surface(const mf_wall *w, const double x[3], double l0, double out_a
 int mf_bodies_accept(mf_walls *ws, double t, double dt);
 
 /* Open postProcessing/<body>/bodyState.csv under post_dir (created) for
- * each body and write the row of the initial state at time t. */
-int mf_bodies_open_output(mf_walls *ws, const char *post_dir, double t);
+ * each body and write the row of the initial state at time t; on a restart
+ * (from a snapshot at t) keep the file's rows up to t and append. */
+int mf_bodies_open_output(mf_walls *ws, const char *post_dir, double t, bool restart);
 
 /* The body's mass and its linear and angular momentum (angular about its
  * centre of mass), committed, and the pending impulses J^n, H^n. */
@@ -79,5 +88,10 @@ typedef struct mf_body_momentum {
     double impulse[3], angular_impulse[3];
 } mf_body_momentum;
 void mf_body_get(const mf_wall *w, mf_body_momentum *out);
+
+/* A restart: the committed state (and pending impulses) from a snapshot's
+ * /RigidBodies/<name> (mf_body_get's fields; mass checked against the
+ * case's, where names the snapshot group for the message). */
+int mf_body_set(mf_wall *w, const mf_body_momentum *s, const char *where);
 
 #endif

@@ -79,6 +79,7 @@ typedef struct mf_motion {
     /* rigid: density or mass and principal inertia (body axes), gravity;
      * origin is the centre of mass (origin_given: the case gave it). */
     double density, mass, inertia[3], g[3];
+    double restitution; /* rigid: of its contacts (body_contact.c) */
     bool origin_given;
 } mf_motion;
 

@@ -13,23 +13,8 @@
 #include "mf_error.h"
 #include "mf_mat3.h"
 #include "mf_fs.h"
+#include "bodies_internal.h"
 
-typedef struct mf_body {
-    double mass;
-    double Ib[9], Ib_inv[9];  /* inertia about the centre of mass, body axes */
-    /* committed state at t^n */
-    double x[3], v[3], R[9], L[3], w[3];
-    /* the impulses of the step that ended at t^n: J = F dt, H = T dt */
-    double J[3], H[3];
-    /* the step being tried (mf_bodies_set_trial) */
-    double xt[3], vt[3], Rt[9], Lt[3], wt[3];
-    /* the surface its wall particles stand for (mf_body_surface_prepare):
-     * per box face (xmin xmax ymin ymax zmin zmax), or of a round shape, the
-     * area of the surface per wall particle within l0 of it */
-    bool surface_ready;
-    double face_area[6], round_area;
-    FILE *csv;
-} mf_body;
 
 /* Inverse of a symmetric positive definite 3x3 matrix (the adjugate). */
 static bool invert3(const double A[9], double B[9])
@@ -208,7 +193,35 @@ void mf_bodies_set_committed(mf_walls *ws)
     }
 }
 
-void mf_bodies_set_trial(mf_walls *ws, double dt)
+void mf_body_finish_trial(mf_wall *w, int dim, double dt)
+{
+    mf_body *b = w->body;
+    double a[3], dw[3], Linv[3], wb[3];
+    if (dim == 2)
+        b->Lt[0] = b->Lt[1] = 0;
+    /* w = R I_b^-1 R^T L with the orientation at t^n */
+    mf_mat3_t_vec(b->R, b->Lt, Linv);
+    mf_mat3_vec(b->Ib_inv, Linv, wb);
+    mf_mat3_vec(b->R, wb, b->wt);
+    for (int c = 0; c < 3; c++)
+        b->xt[c] = b->x[c] + dt * b->vt[c];
+    const double speed = sqrt(b->wt[0] * b->wt[0] + b->wt[1] * b->wt[1] + b->wt[2] * b->wt[2]);
+    if (speed > 0) {
+        const double axis[3] = {b->wt[0] / speed, b->wt[1] / speed, b->wt[2] / speed};
+        double dR[9];
+        mf_rotation_matrix(axis, speed * dt, dR);
+        mf_mat3_mul(dR, b->R, b->Rt);
+    } else {
+        memcpy(b->Rt, b->R, sizeof b->R);
+    }
+    for (int c = 0; c < 3; c++) {
+        a[c] = dt > 0 ? (b->vt[c] - b->v[c]) / dt : 0;
+        dw[c] = dt > 0 ? (b->wt[c] - b->w[c]) / dt : 0;
+    }
+    to_state(w, b->xt, b->Rt, b->vt, b->wt, a, dw);
+}
+
+int mf_bodies_set_trial(mf_walls *ws, const mf_particles *p, double dt)
 {
     for (size_t k = 0; ws && k < ws->n; k++) {
         mf_wall *w = &ws->w[k];
@@ -216,34 +229,15 @@ void mf_bodies_set_trial(mf_walls *ws, double dt)
         if (!b)
             continue;
         const int dim = ws->dim;
-        double a[3], dw[3], Linv[3], wb[3];
         for (int c = 0; c < 3; c++) {
             b->vt[c] = c < dim ? b->v[c] + b->J[c] / b->mass + dt * w->motion.g[c] : 0;
             b->Lt[c] = b->L[c] + b->H[c];
-            b->xt[c] = b->x[c] + dt * b->vt[c];
         }
-        if (dim == 2)
-            b->Lt[0] = b->Lt[1] = 0;
-        /* w = R I_b^-1 R^T L with the orientation at t^n */
-        mf_mat3_t_vec(b->R, b->Lt, Linv);
-        mf_mat3_vec(b->Ib_inv, Linv, wb);
-        mf_mat3_vec(b->R, wb, b->wt);
-        const double speed = sqrt(b->wt[0] * b->wt[0] + b->wt[1] * b->wt[1] +
-                                  b->wt[2] * b->wt[2]);
-        if (speed > 0) {
-            const double axis[3] = {b->wt[0] / speed, b->wt[1] / speed, b->wt[2] / speed};
-            double dR[9];
-            mf_rotation_matrix(axis, speed * dt, dR);
-            mf_mat3_mul(dR, b->R, b->Rt);
-        } else {
-            memcpy(b->Rt, b->R, sizeof b->R);
-        }
-        for (int c = 0; c < 3; c++) {
-            a[c] = dt > 0 ? (b->vt[c] - b->v[c]) / dt : 0;
-            dw[c] = dt > 0 ? (b->wt[c] - b->w[c]) / dt : 0;
-        }
-        to_state(w, b->xt, b->Rt, b->vt, b->wt, a, dw);
+        mf_body_finish_trial(w, dim, dt);
     }
+    if (ws && p)
+        MF_CALL(mf_bodies_contact(ws, p, dt));
+    return 0;
 }
 
 void mf_bodies_clear_forces(mf_walls *ws)
@@ -341,7 +335,41 @@ int mf_bodies_accept(mf_walls *ws, double t, double dt)
     return 0;
 }
 
-int mf_bodies_open_output(mf_walls *ws, const char *post_dir, double t)
+/* A restart at time t: the rows of path up to t (the previous run's, which
+ * may have gone on past its last snapshot) are kept and the file is opened
+ * to append; false when there is no such file. */
+static int reopen_at(mf_body *b, const char *path, double t, bool *kept)
+{
+    *kept = false;
+    FILE *in = fopen(path, "r");
+    if (!in)
+        return 0;
+    char tmp[4500];
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    FILE *out = fopen(tmp, "w");
+    if (!out) {
+        fclose(in);
+        return MF_ERROR(MF_ERR_IO, "cannot write %s: %s", tmp, strerror(errno));
+    }
+    char line[4096];
+    while (fgets(line, sizeof line, in)) {
+        char *end;
+        const double row_t = strtod(line, &end);
+        /* comments and the column names stay; rows up to t (%.9g of it) */
+        if (end == line || row_t <= t + 1e-9 * fmax(fabs(t), 1e-300))
+            fputs(line, out);
+    }
+    fclose(in);
+    if (fclose(out) != 0 || rename(tmp, path) != 0)
+        return MF_ERROR(MF_ERR_IO, "cannot write %s: %s", path, strerror(errno));
+    b->csv = fopen(path, "a");
+    if (!b->csv)
+        return MF_ERROR(MF_ERR_IO, "cannot write %s: %s", path, strerror(errno));
+    *kept = true;
+    return 0;
+}
+
+int mf_bodies_open_output(mf_walls *ws, const char *post_dir, double t, bool restart)
 {
     if (mf_bodies_count(ws) == 0)
         return 0;
@@ -357,6 +385,12 @@ int mf_bodies_open_output(mf_walls *ws, const char *post_dir, double t)
         snprintf(path, sizeof path, "%s/%s/bodyState.csv", post_dir, w->name);
         if (b->csv)
             fclose(b->csv);
+        b->csv = NULL;
+        bool kept = false;
+        if (restart)
+            MF_CALL(reopen_at(b, path, t, &kept));
+        if (kept)
+            continue;
         b->csv = fopen(path, "w");
         if (!b->csv)
             return MF_ERROR(MF_ERR_IO, "cannot write %s: %s", path, strerror(errno));
@@ -386,6 +420,34 @@ void mf_body_get(const mf_wall *w, mf_body_momentum *out)
         out->impulse[c] = b->J[c];
         out->angular_impulse[c] = b->H[c];
     }
+}
+
+int mf_body_set(mf_wall *w, const mf_body_momentum *s, const char *where)
+{
+    mf_body *b = w->body;
+    if (!b)
+        return MF_ERROR(MF_ERR_INTERNAL, "%s: '%s' is not a rigid body", where, w->name);
+    if (!(fabs(s->mass - b->mass) <= 1e-12 * b->mass))
+        return MF_ERROR(MF_ERR_INPUT, "cannot restart: %s holds rigid body '%s' of mass %.9g, "
+                        "the case's (constant/geometry) is %.9g: start a new run", where,
+                        w->name, s->mass, b->mass);
+    memcpy(b->R, s->rotation, sizeof b->R);
+    for (int c = 0; c < 3; c++) {
+        b->x[c] = s->centre[c];
+        b->v[c] = s->velocity[c];
+        b->w[c] = s->omega[c];
+        b->L[c] = s->angular[c];
+        b->J[c] = s->impulse[c];
+        b->H[c] = s->angular_impulse[c];
+    }
+    memcpy(b->xt, b->x, sizeof b->x);
+    memcpy(b->vt, b->v, sizeof b->v);
+    memcpy(b->Rt, b->R, sizeof b->R);
+    memcpy(b->Lt, b->L, sizeof b->L);
+    memcpy(b->wt, b->w, sizeof b->w);
+    static const double zero[3] = {0, 0, 0};
+    to_state(w, b->x, b->R, b->v, b->w, zero, zero);
+    return 0;
 }
 
 /* Depth of body point xb below each face of a box (xmin xmax ymin ...). */

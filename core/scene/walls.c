@@ -281,9 +281,11 @@ int mf_walls_advance(mf_walls *ws, mf_particles *p, double t_from, double t_to)
     for (size_t k = 0; k < ws->n; k++)
         from[k] = ws->w[k].state;
     mf_walls_set_time(ws, t_to);
-    mf_bodies_set_trial(ws, t_to - t_from);
-    mf_walls_move_particles(ws, from, p);
+    const int rc = mf_bodies_set_trial(ws, p, t_to - t_from);
+    if (rc == 0)
+        mf_walls_move_particles(ws, from, p);
     free(from);
+    MF_CALL(rc);
     return 0;
 }
 

@@ -27,7 +27,7 @@ typedef struct motion_settings {
     const char *type, *interpolation;
     double origin[3], axis[3], velocity[3], amplitude[3];
     double omega, angle_amplitude, cycles;
-    double density, mass, inertia[3], g[3]; /* rigid */
+    double density, mass, inertia[3], g[3], restitution; /* rigid */
 } motion_settings;
 
 const mf_param mf_motion_params[] = {
@@ -65,6 +65,9 @@ const mf_param mf_motion_params[] = {
      "axes x, y, z, kg m^2 (2-D: only z, kg m)"},
     {"g", MF_PARAM_VECTOR, "(0 -9.81 0)", -1e6, 1e6, NULL, offsetof(motion_settings, g),
      "rigid: acceleration of gravity on the body, m/s^2 (the gravity force's g)"},
+    {"restitution", MF_PARAM_SCALAR, "0", 0, 1, NULL, offsetof(motion_settings, restitution),
+     "rigid: coefficient of restitution of its contact with walls, obstacles and other bodies "
+     "(0: the approach stops, 1: it bounces back at the speed it came)"},
 };
 const size_t mf_motion_nparams = sizeof mf_motion_params / sizeof mf_motion_params[0];
 const mf_param_section mf_motion_sections[] = {
@@ -249,6 +252,7 @@ int mf_motion_read(const mf_dict *d, int dim, mf_motion *m)
     m->angle_amplitude = s.angle_amplitude * M_PI / 180;
     m->cycles = s.cycles;
     m->density = s.density;
+    m->restitution = s.restitution;
     m->mass = s.mass;
     m->origin_given = mf_dict_find(d, "origin") != NULL;
     for (int a = 0; a < 3; a++) {

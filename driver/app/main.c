@@ -221,18 +221,17 @@ static int run_case(mf_app *app)
                                   ? mf_app_remove_stale_tmp(app->cs.dir, &app->log, &stale)
                                   : 0));
     bool restart = mf_app_is_restart(app);
-    if (mf_bodies_count(app->sim.walls) > 0) {
-        /* Rigid bodies (mf_bodies.h): one rank, a fresh start at time 0. */
+    const bool bodies = mf_bodies_count(app->sim.walls) > 0;
+    if (bodies) {
+        /* Rigid bodies (mf_bodies.h): one rank; time 0 or a restart, whose
+         * snapshot holds their state (/RigidBodies). */
         if (app->sim.par)
             return MF_ERROR(MF_ERR_INPUT, "rigid bodies (motion type rigid) run on one rank only "
                             "for now: run without -parallel");
-        if (restart || app->sim.time != 0)
-            return MF_ERROR(MF_ERR_INPUT, "rigid bodies (motion type rigid) start at time 0: "
-                            "their state is not in the snapshots yet (no -latestTime, "
-                            "startTime 0)");
-        char post[4400];
-        snprintf(post, sizeof post, "%s/postProcessing", app->cs.dir);
-        MF_CALL(mf_bodies_open_output(app->sim.walls, post, app->sim.time));
+        if (!restart && app->sim.time != 0)
+            return MF_ERROR(MF_ERR_INPUT, "rigid bodies (motion type rigid) start at time 0 or "
+                            "restart from a snapshot (startFrom latestTime, -latestTime): their "
+                            "state at startTime %g is not known", app->sim.time);
     }
     if (restart) {
         const mf_writer_ops *w = (const mf_writer_ops *)app->writer.info;
@@ -241,8 +240,14 @@ static int run_case(mf_app *app)
         MF_CALL(w->read_latest(app->writer.data, &app->sim));
         mf_log_printf(&app->log, MF_LOG_NORMAL, "Restarting from time %g (step %ld)\n",
                       app->sim.time, app->sim.step);
+        mf_bodies_set_committed(app->sim.walls);
     } else if (app->sim.time != 0) { /* a fresh scene at startTime: solids where they are then */
         MF_CALL(mf_walls_advance(app->sim.walls, app->sim.p, 0, app->sim.time));
+    }
+    if (bodies) {
+        char post[4400];
+        snprintf(post, sizeof post, "%s/postProcessing", app->cs.dir);
+        MF_CALL(mf_bodies_open_output(app->sim.walls, post, app->sim.time, restart));
     }
     MF_CALL(mf_parallel_agree(app->sim.par, mf_app_distribute(app)));
     if (mf_parallel_is_root(app->sim.par))

@@ -27,6 +27,7 @@ static const mf_metric_ops *const metrics[] = {
     &mf_metric_resting_tank,
     &mf_metric_target_fraction,
     &mf_metric_floating,
+    &mf_metric_water_entry,
 };
 
 int mf_post_register_all(mf_registry *reg)

@@ -29,7 +29,8 @@ extern const mf_metric_ops mf_metric_surge_front, mf_metric_hydrostatic,
     mf_metric_scalar_advection, mf_metric_volume_flux, mf_metric_laplace,
     mf_metric_oscillation, mf_metric_layering, mf_metric_rayleigh_taylor,
     mf_metric_fluid_surge_front, mf_metric_poiseuille, mf_metric_couette, mf_metric_sloshing,
-    mf_metric_containment, mf_metric_resting_tank, mf_metric_target_fraction, mf_metric_floating;
+    mf_metric_containment, mf_metric_resting_tank, mf_metric_target_fraction, mf_metric_floating,
+    mf_metric_water_entry;
 
 /* Snapshots with their times (from the headers), ascending. Free both. */
 int mf_snapshot_times(const char *case_dir, int **indices, double **times, size_t *n);

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "mf_alloc.h"
+#include "mf_bodies.h"
 #include "hdf5_internal.h"
 #include "mf_error.h"
 #include "mf_hdf5.h"
@@ -343,6 +344,48 @@ static int read_particles(snap_reader *r, mf_sim *sim, const mf_hdf5_header *h)
     return 0;
 }
 
+/* /RigidBodies/<name> (hdf5_writer.c's write_bodies) into the case's bodies:
+ * a restart goes on with each body's state, impulses included. Only when
+ * the reading sim has bodies (a metric reads snapshots without a scene). */
+static int read_bodies(hid_t file, const char *path, mf_sim *sim)
+{
+    mf_walls *ws = sim->walls;
+    if (mf_bodies_count(ws) == 0)
+        return 0;
+    char what[MF_H5_PATH_MAX + 128], link[128];
+    for (size_t k = 0; k < ws->n; k++) {
+        mf_wall *w = &ws->w[k];
+        if (!w->body)
+            continue;
+        snprintf(link, sizeof link, "RigidBodies/%s", w->name);
+        snprintf(what, sizeof what, "%s:/%s", path, link);
+        if (H5Lexists(file, "RigidBodies", H5P_DEFAULT) <= 0 ||
+            H5Lexists(file, link, H5P_DEFAULT) <= 0)
+            return MF_ERROR(MF_ERR_INPUT, "cannot restart: snapshot %s has no state of rigid "
+                            "body '%s' (/%s)", path, w->name, link);
+        hid_t g = H5Gopen2(file, link, H5P_DEFAULT);
+        if (g < 0)
+            return MF_ERROR(MF_ERR_IO, "%s: cannot open the group", what);
+        mf_body_momentum b;
+        memset(&b, 0, sizeof b);
+        const struct {
+            const char *name;
+            double *v;
+            size_t n;
+        } a[] = {{"Mass", &b.mass, 0},           {"Centre", b.centre, 3},
+                 {"Rotation", b.rotation, 9},    {"Velocity", b.velocity, 3},
+                 {"AngularVelocity", b.omega, 3}, {"AngularMomentum", b.angular, 3},
+                 {"Impulse", b.impulse, 3},      {"AngularImpulse", b.angular_impulse, 3}};
+        int rc = 0;
+        for (size_t i = 0; rc == 0 && i < sizeof a / sizeof a[0]; i++)
+            rc = mf_h5_attr_read(g, a[i].name, H5T_NATIVE_DOUBLE, a[i].n, a[i].v, what);
+        H5Gclose(g);
+        MF_CALL(rc);
+        MF_CALL(mf_body_set(w, &b, what));
+    }
+    return 0;
+}
+
 int mf_hdf5_read_snapshot(const char *path, mf_sim *sim)
 {
     mf_h5_quiet quiet;
@@ -357,6 +400,8 @@ int mf_hdf5_read_snapshot(const char *path, mf_sim *sim)
             r.total += (size_t)h.npart[k];
         rc = read_particles(&r, sim, &h);
     }
+    if (rc == 0)
+        rc = read_bodies(r.file, path, sim);
     mf_h5_close(&r.file);
     mf_h5_quiet_end(&quiet);
     free(r.filled);
