@@ -11,7 +11,14 @@
  *            Laplacian, eq. 18 surface, no shifting, no collision. Today's
  *            results bit for bit (tests/test_paper_scheme.sh).
  *   robust   the MPS solver's default: the mixed source (Tanaka & Masunaga
- *            2010) with densityFactor 0.2, the paper's gradient and
+ *            2010) with densityFactor 0.2, its divergence in the
+ *            higher-order form of Khayyer & Gotoh 2009 (mixedHigherOrder,
+ *            mps_source.c: with eq. 6's divergence at the gradient's
+ *            radius the projection amplified the particle-scale noise
+ *            until bench/cases/damBreak2D_l0_0.005 blew up at t = 0.18 s;
+ *            docs/notes/mps.md, 2026-12-02 robust; with `wall wallWeight`,
+ *            whose wall terms are written for eq. 6, the mixed source as
+ *            before), the paper's gradient and
  *            Laplacian, free surface by eq. 18 and neighbour asymmetry
  *            (Khayyer et al. 2009), the collision model, no shifting: the
  *            variant that survived the failing cases of issue 13 in the
@@ -41,7 +48,7 @@
 
 const char *const mps_scheme_choices[] = {"paper", "robust", "stabilised", NULL};
 const char *const mps_source_choices[] = {"scheme", "density", "mixed", "higherOrder",
-                                          "errorCompensating", NULL};
+                                          "errorCompensating", "mixedHigherOrder", NULL};
 const char *const mps_gradient_choices[] = {"scheme", "paper", "corrected", "leastSquares", NULL};
 const char *const mps_laplacian_choices[] = {"scheme", "paper", "higherOrder", "leastSquares",
                                              NULL};
@@ -53,7 +60,7 @@ const char *const mps_collision_choices[] = {"scheme", "yes", "no", "true", "fal
 static const mps_scheme schemes[] = {
     {"paper", MPS_SOURCE_DENSITY, MPS_GRADIENT_PAPER, MPS_LAPLACIAN_PAPER, MPS_SHIFT_NONE,
      MPS_DETECT_NUMBER_DENSITY, false, 1.0},
-    {"robust", MPS_SOURCE_MIXED, MPS_GRADIENT_PAPER, MPS_LAPLACIAN_PAPER, MPS_SHIFT_NONE,
+    {"robust", MPS_SOURCE_MIXED_HIGHER_ORDER, MPS_GRADIENT_PAPER, MPS_LAPLACIAN_PAPER, MPS_SHIFT_NONE,
      MPS_DETECT_ASYMMETRY, true, 1.0},
     {"stabilised", MPS_SOURCE_DENSITY, MPS_GRADIENT_PAPER, MPS_LAPLACIAN_PAPER, MPS_SHIFT_NONE,
      MPS_DETECT_NUMBER_DENSITY, true, 0.2},
@@ -78,6 +85,9 @@ int mps_scheme_resolve(const mps_settings *s, int dim, mps_scheme *out)
     if (s->relaxation > 0)
         out->relaxation = s->relaxation;
     /* choice k of a list whose entry 0 is "scheme": the enum value k - 1 */
+    /* wall weight's wall terms are written for eq. 6's divergence (mps_wall.c) */
+    if (out->source == MPS_SOURCE_MIXED_HIGHER_ORDER && s->wall && strcmp(s->wall, "wallWeight") == 0)
+        out->source = MPS_SOURCE_MIXED;
     int c = choice(mps_source_choices, s->source);
     if (c > 0)
         out->source = (mps_source_kind)(c - 1);
@@ -122,7 +132,7 @@ int mps_scheme_reserve(mps_data *d, size_t n)
         return 0;
     const mps_scheme *sc = &d->sc;
     const size_t cap = n + n / 16 + 64;
-    const bool start = sc->source == MPS_SOURCE_MIXED ||
+    const bool start = mps_source_mixed(sc->source) ||
                        sc->source == MPS_SOURCE_ERROR_COMPENSATING;
     int rc = 0;
     if (start)
