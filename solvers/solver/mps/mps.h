@@ -216,9 +216,8 @@ extern const char *const mps_scheme_choices[], *const mps_source_choices[],
      "pressure gradient with p_min of the neighbourhood (eq. 5 note)"},                         \
     {"scheme", MF_PARAM_WORD, SCHEME, MF_NO_RANGE, mps_scheme_choices, OFF(scheme),             \
      "the scheme: the defaults of source, gradient, laplacian, shifting, surfaceDetection "      \
-     "and collision (paper: eqs. 5, 7, 14, 18 as printed; robust: mixedHigherOrder source "      \
-     "(mixed with wall wallWeight), asymmetry surface test, collision; stabilised: paper with "  \
-     "relaxation 0.2 and collision)"},                                                           \
+     "and collision (paper: eqs. 5, 7, 14, 18 as printed; robust: mixed source, asymmetry "     \
+     "surface test, collision; stabilised: paper with relaxation 0.2 and collision)"},           \
     {"source", MF_PARAM_WORD, "scheme", MF_NO_RANGE, mps_source_choices, OFF(source),          \
      "source term of the pressure equation: density (eq. 14), mixed (Tanaka & Masunaga 2010), " \
      "higherOrder (Khayyer & Gotoh 2009), errorCompensating (Khayyer & Gotoh 2011), "            \

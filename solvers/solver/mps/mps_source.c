@@ -15,17 +15,21 @@
  * Its main term grows as 1/dt, not 1/dt^2: a shorter step does not amplify
  * the particle-scale noise of n*.
  *
- * mixedHigherOrder (robust's): the mixed source with its divergence in the
+ * mixedHigherOrder: the mixed source with its divergence in the
  * higher-order form of Khayyer & Gotoh 2009 (below), -<div u*>_i =
  * (Dn/Dt)*_i / n0 by continuity:
  *   s_i = (Dn/Dt)*_i / (n0 dt) + gamma (n^k_i - n0) / (n0 dt^2).
  * Eq. 6 at the gradient's radius (2.1 l0) sees a particle's nearest ring
  * only, and projecting its particle-scale noise away with the PPE's wider
  * Laplacian (3.1 l0) fed the noise back: on damBreak2D at l0 0.005 and a
- * fixed dt 4e-4 the RMS of that term grew eightfold in 0.05 s and the
- * pressure flipped sign from step to step until the run blew up at 0.18 s;
- * the Dn/Dt form, a sum over the number density's radius, did not
- * (docs/notes/mps.md, 2026-12-02 robust).
+ * fixed dt 4e-4 the RMS of that term over the interior grew from 2.4e3 to
+ * 1.8e4 s^-2 between t = 0.10 and 0.14 s, the pressure flipped sign from
+ * step to step, and the run blew up at 0.18 s; the Dn/Dt form, a sum over
+ * the number density's radius, did not. But it resists a particle's close
+ * approach to a wall less (more weight on distant pairs): the obstacle dam
+ * break stops at l0 0.00487 and 0.00365 with throughWall at the far wall,
+ * where `mixed` completes (docs/notes/mps.md, 2026-12-02 robust).
+
  *
  * higherOrder (Khayyer & Gotoh 2009, Coastal Eng. 56, 419-440, eqs. 11-13):
  * the rate of the number density from the pair velocities,
