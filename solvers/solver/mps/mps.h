@@ -36,7 +36,7 @@ typedef struct mps_settings {
     /* The scheme (mps_scheme.c): a named set of the five choices below,
      * each of which a case may set apart ("scheme": the scheme's). */
     const char *scheme;       /* paper | robust | stabilised */
-    const char *source;       /* PPE source: density | mixed | higherOrder | errorCompensating */
+    const char *source;       /* PPE source: density | mixed | higherOrder | errorCompensating | mixedHigherOrder */
     const char *gradient;     /* pressure gradient: paper | corrected | leastSquares */
     const char *laplacian;    /* paper | higherOrder | leastSquares */
     const char *shifting;     /* none | fickian */
@@ -66,8 +66,15 @@ typedef enum {
     MPS_SOURCE_DENSITY,            /* eq. 14: relaxation (rho/dt^2)(n* - n0)/n0 */
     MPS_SOURCE_MIXED,              /* Tanaka & Masunaga 2010 */
     MPS_SOURCE_HIGHER_ORDER,       /* Khayyer & Gotoh 2009 (HS) */
-    MPS_SOURCE_ERROR_COMPENSATING  /* Khayyer & Gotoh 2011 (HS + ECS) */
+    MPS_SOURCE_ERROR_COMPENSATING, /* Khayyer & Gotoh 2011 (HS + ECS) */
+    MPS_SOURCE_MIXED_HIGHER_ORDER  /* mixed, its divergence as HS (robust's) */
 } mps_source_kind;
+
+/* Does the source need n at r^n (the mixed forms and ECS's density terms)? */
+static inline bool mps_source_mixed(mps_source_kind s)
+{
+    return s == MPS_SOURCE_MIXED || s == MPS_SOURCE_MIXED_HIGHER_ORDER;
+}
 typedef enum { MPS_GRADIENT_PAPER, MPS_GRADIENT_CORRECTED, MPS_GRADIENT_LEAST_SQUARES } mps_gradient_kind;
 typedef enum { MPS_LAPLACIAN_PAPER, MPS_LAPLACIAN_HIGHER_ORDER, MPS_LAPLACIAN_LEAST_SQUARES } mps_laplacian_kind;
 typedef enum { MPS_SHIFT_NONE, MPS_SHIFT_FICKIAN } mps_shift_kind;
@@ -111,7 +118,7 @@ typedef struct mps_data {
     size_t cap_slot;
     /* The scheme's work arrays (mps_source.c, mps_shift.c), NULL where the
      * scheme does not use them; one entry per particle unless said. */
-    double *n_start;   /* n at r^n (mixed, errorCompensating) */
+    double *n_start;   /* n at r^n (mixed, mixedHigherOrder, errorCompensating) */
     double *rate_start; /* Dn/Dt at r^n, u^n (errorCompensating) */
     double *src;       /* the PPE source / rho of the unknowns (NULL: eq. 14 as printed) */
     double *work;      /* 3n, 15n with shifting: scratch (divergence, minimum, asymmetry, shifting) */
@@ -213,9 +220,10 @@ extern const char *const mps_scheme_choices[], *const mps_source_choices[],
      "surface test, collision; stabilised: paper with relaxation 0.2 and collision)"},           \
     {"source", MF_PARAM_WORD, "scheme", MF_NO_RANGE, mps_source_choices, OFF(source),          \
      "source term of the pressure equation: density (eq. 14), mixed (Tanaka & Masunaga 2010), " \
-     "higherOrder (Khayyer & Gotoh 2009), errorCompensating (Khayyer & Gotoh 2011)"},           \
+     "higherOrder (Khayyer & Gotoh 2009), errorCompensating (Khayyer & Gotoh 2011), "            \
+     "mixedHigherOrder (mixed with the divergence in Khayyer & Gotoh 2009's form)"},             \
     {"densityFactor", MF_PARAM_SCALAR, "0.2", 0, 1, NULL, OFF(density_factor),                \
-     "source mixed: weight gamma of the density-deviation term"},                              \
+     "source mixed, mixedHigherOrder: weight gamma of the density-deviation term"},            \
     {"gradient", MF_PARAM_WORD, "scheme", MF_NO_RANGE, mps_gradient_choices, OFF(gradient),    \
      "pressure gradient: paper (eq. 5), corrected (CMPS, Khayyer & Gotoh 2008), "               \
      "leastSquares (LSMPS, Tamai & Koshizuka 2014)"},                                           \
@@ -237,7 +245,8 @@ extern const char *const mps_scheme_choices[], *const mps_source_choices[],
      "fraction of a flat surface's"},                                                           \
     {"retrySource", MF_PARAM_BOOL, "yes", MF_NO_RANGE, NULL, OFF(retry_source),                 \
      "when the watch retries a step with a shorter dt, keep the density terms of the source "   \
-     "(mixed, errorCompensating) at the first attempt's strength (eq. 14 stays as printed)"},    \
+     "(mixed, mixedHigherOrder, errorCompensating) at the first attempt's strength (eq. 14 "    \
+     "stays as printed)"},                                                                       \
     {"collision", MF_PARAM_WORD, "scheme", MF_NO_RANGE, mps_collision_choices,                 \
      OFF(collision_choice),                                                                     \
      "push apart particles closer than collisionDistance (yes/no; the paper uses none)"},      \

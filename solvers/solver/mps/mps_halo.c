@@ -100,11 +100,9 @@ int mps_halo_create(mps_data *d, mf_sim *sim)
                       d->s.periodic_origin, d->s.periodic_origin + d->s.periodic_length, rmax);
     }
     mh->star = mh->spec;
-    /* At r* the paper's PPE and the correction read no velocity; the mixed
-     * and error-compensating sources read the neighbours' u* (div u*,
-     * Dn/Dt at r*: mps_source_terms). */
-    mh->star.velocities = d->sc.source == MPS_SOURCE_MIXED ||
-                          d->sc.source == MPS_SOURCE_ERROR_COMPENSATING;
+    /* At r* the paper's PPE and the correction read no velocity; the other
+     * sources read the neighbours' u* (div u*, Dn/Dt at r*: mps_source_terms). */
+    mh->star.velocities = d->sc.source != MPS_SOURCE_DENSITY;
     d->halo = mh;
     return 0;
 }

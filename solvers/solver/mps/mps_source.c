@@ -15,6 +15,22 @@
  * Its main term grows as 1/dt, not 1/dt^2: a shorter step does not amplify
  * the particle-scale noise of n*.
  *
+ * mixedHigherOrder: the mixed source with its divergence in the
+ * higher-order form of Khayyer & Gotoh 2009 (below), -<div u*>_i =
+ * (Dn/Dt)*_i / n0 by continuity:
+ *   s_i = (Dn/Dt)*_i / (n0 dt) + gamma (n^k_i - n0) / (n0 dt^2).
+ * Eq. 6 at the gradient's radius (2.1 l0) sees a particle's nearest ring
+ * only, and projecting its particle-scale noise away with the PPE's wider
+ * Laplacian (3.1 l0) fed the noise back: on damBreak2D at l0 0.005 and a
+ * fixed dt 4e-4 the RMS of that term over the interior grew from 2.4e3 to
+ * 1.8e4 s^-2 between t = 0.10 and 0.14 s, the pressure flipped sign from
+ * step to step, and the run blew up at 0.18 s; the Dn/Dt form, a sum over
+ * the number density's radius, did not. But it resists a particle's close
+ * approach to a wall less (more weight on distant pairs): the obstacle dam
+ * break stops at l0 0.00487 and 0.00365 with throughWall at the far wall,
+ * where `mixed` completes (docs/notes/mps.md, 2026-12-02 robust).
+
+ *
  * higherOrder (Khayyer & Gotoh 2009, Coastal Eng. 56, 419-440, eqs. 11-13):
  * the rate of the number density from the pair velocities,
  *   s_i = (Dn/Dt)*_i / (n0 dt),  Dn/Dt_i = sum_j -re (r_ij . u_ij) / |r_ij|^3
@@ -41,7 +57,7 @@
 int mps_source_start(mps_data *d, mf_sim *sim)
 {
     const mps_source_kind src = d->sc.source;
-    if (src != MPS_SOURCE_MIXED && src != MPS_SOURCE_ERROR_COMPENSATING)
+    if (!mps_source_mixed(src) && src != MPS_SOURCE_ERROR_COMPENSATING)
         return 0;
     MF_CALL(mps_scheme_reserve(d, sim->p->n));
     mf_pairs v;
@@ -78,6 +94,13 @@ int mps_source_terms(mps_data *d, const mf_sim *sim, double dt)
     }
     MF_CALL(mps_pairs(d, sim, d->h_nd, &v));
     mf_number_density_rate(&v, p->vel, d->in_ppe, NULL, rate);
+    if (src == MPS_SOURCE_MIXED_HIGHER_ORDER) {
+        const double gamma = d->s.density_factor * scale;
+        for (size_t i = 0; i < p->n_owned; i++)
+            if (d->in_ppe[i])
+                d->src[i] = rate[i] / (n0 * dt) + gamma * (d->n_start[i] - n0) / (n0 * dt2);
+        return 0;
+    }
     for (size_t i = 0; i < p->n_owned; i++) {
         if (!d->in_ppe[i])
             continue;

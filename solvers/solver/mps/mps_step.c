@@ -142,7 +142,7 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
      * with wall weight, whose share is added to n at r^n (mps_wall.c). */
     const bool nd_with_viscosity = !d->visc && !d->mu && !d->wall && nu > 0 &&
                                    d->sc.laplacian == MPS_LAPLACIAN_PAPER &&
-                                   d->sc.source == MPS_SOURCE_MIXED && d->k_nd.re == d->k_lap.re;
+                                   mps_source_mixed(d->sc.source) && d->k_nd.re == d->k_lap.re;
     if (d->wall) /* wall weight: the walls' sums at r^n */
         MF_CALL(mps_wall_points(d, sim));
     if (nd_with_viscosity)
