@@ -210,6 +210,43 @@ static long log_total(const tc_case *c, const char *prefix, int which)
     return v;
 }
 
+/* The fluid points of every snapshot of a run: their count at the start,
+ * its range, and how many points lay outside the walls' bounds (the first
+ * five named on stderr with the label). */
+typedef struct fluid_bounds {
+    double lo[2], hi[2]; /* x, y */
+} fluid_bounds;
+typedef struct fluid_census {
+    size_t n0, lo, hi, outside;
+} fluid_census;
+
+static fluid_census census(const char *dir, const tc_snapshots *s, const fluid_bounds *b,
+                           const char *label)
+{
+    fluid_census k = {0, SIZE_MAX, 0, 0};
+    for (size_t t = 0; t < s->n; t++) {
+        mf_sim snap;
+        if (tc_snapshot_load(dir, s->index[t], &snap, NULL) != 0) {
+            CHECK(!"snapshot readable");
+            continue;
+        }
+        size_t n = tc_count_kind(snap.p, MF_FLUID);
+        k.n0 = t == 0 ? n : k.n0;
+        k.lo = n < k.lo ? n : k.lo;
+        k.hi = n > k.hi ? n : k.hi;
+        for (size_t i = 0; i < snap.p->n; i++) {
+            const double *x = &snap.p->pos[3 * i];
+            if (snap.p->kind[i] == MF_FLUID && (x[0] < b->lo[0] || x[0] > b->hi[0] ||
+                                                x[1] < b->lo[1] || x[1] > b->hi[1]) &&
+                k.outside++ < 5)
+                fprintf(stderr, "%s: fluid point id %lld at (%g %g) is past a wall\n", label,
+                        (long long)snap.p->id[i], x[0], x[1]);
+        }
+        tc_sim_free(&snap);
+    }
+    return k;
+}
+
 static void channel_run(const char *exe, const char *rule, double tolerance)
 {
     char solver[512];
@@ -233,29 +270,10 @@ static void channel_run(const char *exe, const char *rule, double tolerance)
     }
     tc_snapshots s;
     CHECK_OK(tc_snapshots_list(c.dir, &s));
-    size_t n0 = 0, lo = SIZE_MAX, hi = 0, outside = 0;
-    for (size_t k = 0; k < s.n; k++) {
-        mf_sim snap;
-        if (tc_snapshot_load(c.dir, s.index[k], &snap, NULL) != 0) {
-            CHECK(!"snapshot readable");
-            continue;
-        }
-        size_t n = tc_count_kind(snap.p, MF_FLUID);
-        if (k == 0)
-            n0 = n;
-        lo = n < lo ? n : lo;
-        hi = n > hi ? n : hi;
-        for (size_t i = 0; i < snap.p->n; i++) {
-            const double *x = &snap.p->pos[3 * i];
-            /* Wall particle lines at y = -l0/2 and 0.1 + l0/2. */
-            if (snap.p->kind[i] == MF_FLUID && (x[1] < -0.01 || x[1] > 0.11)) {
-                if (outside++ < 5)
-                    fprintf(stderr, "rule %s: fluid point id %lld at (%g %g) is past a wall\n",
-                            rule, (long long)snap.p->id[i], x[0], x[1]);
-            }
-        }
-        tc_sim_free(&snap);
-    }
+    /* Wall particle lines at y = -l0/2 and 0.1 + l0/2. */
+    const fluid_bounds walls = {{-INFINITY, -0.01}, {INFINITY, 0.11}};
+    fluid_census k = census(c.dir, &s, &walls, rule);
+    const size_t n0 = k.n0, lo = k.lo, hi = k.hi, outside = k.outside;
     long added = log_total(&c, "MAFL points: added ", 0);
     long merged = log_total(&c, "MAFL points: added ", 1);
     long drained = log_total(&c, "Emitters over the run: added ", 1);
@@ -379,27 +397,10 @@ static void resting_box_run(const char *exe, const char *rule, double l0, double
         tc_case_destroy(&c);
         return;
     }
-    size_t n0 = 0, lo = SIZE_MAX, hi = 0, outside = 0;
-    for (size_t k = 0; k < s.n; k++) {
-        mf_sim snap;
-        if (tc_snapshot_load(c.dir, s.index[k], &snap, NULL) != 0) {
-            CHECK(!"snapshot readable");
-            continue;
-        }
-        size_t n = tc_count_kind(snap.p, MF_FLUID);
-        n0 = k == 0 ? n : n0;
-        lo = n < lo ? n : lo;
-        hi = n > hi ? n : hi;
-        for (size_t i = 0; i < snap.p->n; i++) {
-            const double *x = &snap.p->pos[3 * i];
-            /* The wall faces: x = 0, 0.3, y = 0 (the fluid block's faces). */
-            if (snap.p->kind[i] == MF_FLUID && (x[0] < 0 || x[0] > 0.3 || x[1] < 0) &&
-                outside++ < 5)
-                fprintf(stderr, "resting box: fluid point id %lld at (%g %g) is past a wall face\n",
-                        (long long)snap.p->id[i], x[0], x[1]);
-        }
-        tc_sim_free(&snap);
-    }
+    /* The wall faces: x = 0, 0.3, y = 0 (the fluid block's faces). */
+    const fluid_bounds walls = {{0, 0}, {0.3, INFINITY}};
+    fluid_census k = census(c.dir, &s, &walls, "resting box");
+    const size_t n0 = k.n0, lo = k.lo, hi = k.hi, outside = k.outside;
     printf("resting box (rule %s, l0 %g, %g s, %.1f s): %zu snapshots, fluid points %zu at the "
            "start, in [%zu, %zu]; %zu past a wall face\n",
            rule, l0, end_time, c.last_wall, s.n, n0, lo, hi, outside);
