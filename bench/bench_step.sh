@@ -135,7 +135,9 @@ done
 
 {
     echo "bench/bench_step.sh $quick, $(date -u +%Y-%m-%d): $machine"
-    echo "main: $(cd "${main_tree:-$root}" && git log --oneline -1 | cut -c1-50); this: $(git log --oneline -1 | cut -c1-50)"
+    # Each build as it names itself (a MAIN_MPSFLOW given from elsewhere is
+    # not the checkout's main: the label said main's commit for it).
+    echo "main: $("$MAIN_MPSFLOW" -version 2>&1 | head -n 1); this: $("$MPSFLOW" -version 2>&1 | head -n 1) ($(git log --oneline -1 | cut -c1-50))"
     echo "load (1, 5, 15 min): at start $load_start; with the busy core $load_busy; at the end $load_end"
     echo "medians of $reps interleaved runs; 2-D $steps2d steps, 3-D $steps3d steps, threads $steps_thr steps"
     echo
