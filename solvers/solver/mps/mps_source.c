@@ -29,7 +29,6 @@
  * approach to a wall less (more weight on distant pairs): the obstacle dam
  * break stops at l0 0.00487 and 0.00365 with throughWall at the far wall,
  * where `mixed` completes (docs/notes/mps.md, 2026-12-02 robust).
-
  *
  * higherOrder (Khayyer & Gotoh 2009, Coastal Eng. 56, 419-440, eqs. 11-13):
  * the rate of the number density from the pair velocities,
@@ -70,6 +69,18 @@ int mps_source_start(mps_data *d, mf_sim *sim)
     return 0;
 }
 
+/* The two mixed sources: the velocity term rate / divisor (-div u* over
+ * -dt, or (Dn/Dt)* over n0 dt) plus the density term gamma (n^k - n0) /
+ * (n0 dt^2), gamma densityFactor times the retry's scale. */
+static void mixed_source(mps_data *d, size_t n_owned, const double *rate, double divisor,
+                         double n0, double dt2)
+{
+    const double gamma = d->s.density_factor * d->density_scale;
+    for (size_t i = 0; i < n_owned; i++)
+        if (d->in_ppe[i])
+            d->src[i] = rate[i] / divisor + gamma * (d->n_start[i] - n0) / (n0 * dt2);
+}
+
 int mps_source_terms(mps_data *d, const mf_sim *sim, double dt)
 {
     const mps_source_kind src = d->sc.source;
@@ -86,19 +97,13 @@ int mps_source_terms(mps_data *d, const mf_sim *sim, double dt)
         mf_divergence(&v, &d->k_grad, p->vel, d->in_ppe, d->not_dummy, rate);
         if (d->wall) /* the walls' velocity */
             mps_wall_divergence(d, sim, d->in_ppe, rate);
-        const double gamma = d->s.density_factor * scale;
-        for (size_t i = 0; i < p->n_owned; i++)
-            if (d->in_ppe[i])
-                d->src[i] = -rate[i] / dt + gamma * (d->n_start[i] - n0) / (n0 * dt2);
+        mixed_source(d, p->n_owned, rate, -dt, n0, dt2); /* -div u* / dt */
         return 0;
     }
     MF_CALL(mps_pairs(d, sim, d->h_nd, &v));
     mf_number_density_rate(&v, p->vel, d->in_ppe, NULL, rate);
     if (src == MPS_SOURCE_MIXED_HIGHER_ORDER) {
-        const double gamma = d->s.density_factor * scale;
-        for (size_t i = 0; i < p->n_owned; i++)
-            if (d->in_ppe[i])
-                d->src[i] = rate[i] / (n0 * dt) + gamma * (d->n_start[i] - n0) / (n0 * dt2);
+        mixed_source(d, p->n_owned, rate, n0 * dt, n0, dt2); /* (Dn/Dt)* / (n0 dt) */
         return 0;
     }
     for (size_t i = 0; i < p->n_owned; i++) {
