@@ -330,6 +330,10 @@ static int reduce_forces(mf_walls *ws)
             m += 6;
         }
     mf_parallel_sum(ws->par, sum, (int)(6 * nb));
+    /* MPI does not promise every rank the same rounding of a sum (the order
+     * of its additions may differ by rank): rank 0's, so that no rank's body
+     * drifts from the others' */
+    mf_parallel_bcast(ws->par, sum, 6 * nb * sizeof *sum, 0);
     m = 0;
     for (size_t k = 0; k < ws->n; k++)
         if (ws->w[k].body) {
