@@ -55,20 +55,25 @@ static int cmp_point(const void *a, const void *b)
     return (u->id > v->id) - (u->id < v->id);
 }
 
+/* Particle i is an outer particle of a body (id: the WallId field). */
+static bool is_body_point(const mf_walls *ws, const mf_particles *p, const int32_t *id, size_t i)
+{
+    return id[i] > 0 && (size_t)id[i] <= ws->n && ws->w[id[i] - 1].body &&
+           p->kind[i] == MF_WALL;
+}
+
 static int gather_points(const mf_walls *ws, const mf_particles *p, body_points *out)
 {
     const int32_t *id = mf_particles_fi(p, ws->f_wall_id);
     size_t n = 0;
     for (size_t i = 0; i < p->n_owned; i++)
-        n += id[i] > 0 && (size_t)id[i] <= ws->n && ws->w[id[i] - 1].body &&
-             p->kind[i] == MF_WALL;
+        n += is_body_point(ws, p, id, i);
     body_point *mine = malloc((n ? n : 1) * sizeof *mine);
     if (!mine)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory for the rigid bodies' contacts");
     n = 0;
     for (size_t i = 0; i < p->n_owned; i++) {
-        if (!(id[i] > 0 && (size_t)id[i] <= ws->n && ws->w[id[i] - 1].body &&
-              p->kind[i] == MF_WALL))
+        if (!is_body_point(ws, p, id, i))
             continue;
         mine[n].id = p->id[i];
         mine[n].body = id[i] - 1;
