@@ -442,6 +442,138 @@ static void part_restart(void)
     tc_sim_free(&ref);
 }
 
+/* Rigid bodies (issue 18) on 1, 2 and 3 ranks: floatingBox at twice its
+ * spacing, 50 steps of 1 ms from the box's release on the water. */
+static const case_spec body_case = {"floatingBox", 0.02, 1e-3, "", false, NULL};
+
+#define BODY_ROWS 64
+#define BODY_COLS 20 /* time, centre, quaternion, velocity, omega, force, torque */
+
+/* The rows of postProcessing/box/bodyState.csv; how many (-1: no file). */
+static int read_body_rows(const tc_case *c, double rows[BODY_ROWS][BODY_COLS])
+{
+    char path[700], line[1024];
+    snprintf(path, sizeof path, "%s/postProcessing/box/bodyState.csv", c->dir);
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return -1;
+    int n = 0;
+    while (n < BODY_ROWS && fgets(line, sizeof line, f)) {
+        char *at = line, *end;
+        int k = 0;
+        for (; k < BODY_COLS; k++, at = end + (*end == ',')) {
+            rows[n][k] = strtod(at, &end);
+            if (end == at)
+                break;
+        }
+        n += k == BODY_COLS; /* the comment and the column names are not rows */
+    }
+    fclose(f);
+    return n;
+}
+
+/* The body's trajectory of run b against run a: the same times, and the
+ * centre and velocity within the particles' bounds (POS_BOUND of l0,
+ * VEL_BOUND of the largest speed) at every step. */
+static void compare_body(const char *what, const tc_case *a, const tc_case *b, double l0,
+                         int expect_rows)
+{
+    static double ra[BODY_ROWS][BODY_COLS], rb[BODY_ROWS][BODY_COLS];
+    const int na = read_body_rows(a, ra), nb = read_body_rows(b, rb);
+    CHECK_MSG(na == expect_rows && nb == expect_rows,
+              "%s: bodyState.csv has %d and %d rows, %d expected", what, na, nb, expect_rows);
+    double dx = 0, dv = 0, vmax = 1e-3, dt = 0;
+    for (int r = 0; r < na && r < nb; r++) {
+        dt = fmax(dt, fabs(ra[r][0] - rb[r][0]));
+        for (int c = 0; c < 3; c++) {
+            dx = fmax(dx, fabs(ra[r][1 + c] - rb[r][1 + c]));
+            dv = fmax(dv, fabs(ra[r][8 + c] - rb[r][8 + c]));
+            vmax = fmax(vmax, fabs(ra[r][8 + c]));
+        }
+    }
+    printf("%s: body 'box' over %d rows: max |dx| = %.3g l0, max |dv| = %.3g of %.3g m/s "
+           "(centre at the end %.9g %.9g, velocity %.9g %.9g)\n",
+           what, nb, dx / l0, dv / vmax, vmax, nb > 0 ? rb[nb - 1][1] : 0,
+           nb > 0 ? rb[nb - 1][2] : 0, nb > 0 ? rb[nb - 1][8] : 0, nb > 0 ? rb[nb - 1][9] : 0);
+    CHECK_MSG(dt <= 1e-9, "%s: the rows' times differ by %g s", what, dt);
+    CHECK_MSG(dx <= POS_BOUND * l0, "%s: the body's centre differs by %g l0", what, dx / l0);
+    CHECK_MSG(dv <= VEL_BOUND * vmax, "%s: the body's velocity differs by %g of the largest",
+              what, dv / vmax);
+}
+
+/* The rows of the body's file at the end: the initial state and one a step. */
+#define BODY_STEPS 50
+
+static void part_bodies(void)
+{
+    const case_spec *cs = &body_case;
+    tc_case ref_case;
+    mf_sim ref;
+    memset(&ref, 0, sizeof ref);
+    if (make_case(&ref_case, cs, "bodies-serial", BODY_STEPS, BODY_STEPS) != 0 ||
+        run(&ref_case, 0, cs, NULL) != 0 || load_last(&ref_case, &ref) != 0) {
+        CHECK_MSG(0, "floatingBox: the serial run");
+        tc_case_destroy(&ref_case);
+        return;
+    }
+    const double l0 = ref.l0;
+    /* The box moved: a comparison of bodies at rest would prove nothing. */
+    static double rows[BODY_ROWS][BODY_COLS];
+    const int nr = read_body_rows(&ref_case, rows);
+    CHECK_MSG(nr == BODY_STEPS + 1 && fabs(rows[nr - 1][9]) > 0.1,
+              "floatingBox serial: %d rows, the box's speed %g m/s at the end", nr,
+              nr > 0 ? rows[nr - 1][9] : 0);
+    for (int np = 1; np <= 3; np++) {
+        char tag[64], what[96];
+        snprintf(tag, sizeof tag, "bodies-np%d", np);
+        snprintf(what, sizeof what, "floatingBox on %d rank%s", np, np > 1 ? "s" : "");
+        tc_case c;
+        mf_sim got;
+        memset(&got, 0, sizeof got);
+        if (make_case(&c, cs, tag, BODY_STEPS, BODY_STEPS) == 0 && run(&c, np, cs, NULL) == 0 &&
+            load_last(&c, &got) == 0) {
+            compare(what, &ref, &got, l0, INT64_MAX);
+            compare_body(what, &ref_case, &c, l0, BODY_STEPS + 1);
+        } else {
+            CHECK_MSG(0, "%s: the run", what);
+        }
+        tc_sim_free(&got);
+        tc_case_destroy(&c);
+    }
+    /* Written on 2 ranks at step 25, restarted on 1 (serially) and on 3 to
+     * step 50: the serial run's particles and trajectory, and the file's rows
+     * once each. */
+    for (int np = 0; np <= 3; np += 3) {
+        char tag[64], what[96];
+        snprintf(tag, sizeof tag, "bodies-restart-np%d", np);
+        snprintf(what, sizeof what, "floatingBox written on 2 ranks, restarted on %d",
+                 np ? np : 1);
+        tc_case half;
+        mf_sim got;
+        memset(&got, 0, sizeof got);
+        if (make_case(&half, cs, tag, BODY_STEPS / 2, BODY_STEPS / 2) == 0) {
+            int ok = run(&half, 2, cs, NULL) == 0;
+            char control[512];
+            snprintf(control, sizeof control,
+                     "endTime %.17g;\nadjustTimeStep no;\ndeltaT %.17g;\nwriteControl "
+                     "timeStep;\nwriteInterval %d;\n",
+                     BODY_STEPS * cs->dt, cs->dt, BODY_STEPS / 2);
+            tc_case_write(&half, TC_CONTROL, control);
+            ok = ok && run(&half, np, cs, "-latestTime") == 0 && load_last(&half, &got) == 0;
+            CHECK_MSG(ok, "%s: the runs", what);
+            if (ok) {
+                CHECK(got.step == BODY_STEPS);
+                compare(what, &ref, &got, l0, INT64_MAX);
+                compare_body(what, &ref_case, &half, l0, BODY_STEPS + 1);
+            }
+        }
+        tc_sim_free(&got);
+        tc_case_destroy(&half);
+    }
+    tc_sim_free(&ref);
+    tc_case_destroy(&ref_case);
+}
+
 /* "Load imbalance X, after rebalancing Y" from the log. */
 static bool read_rebalance(const tc_case *c, double *before, double *after)
 {
@@ -484,7 +616,7 @@ static void part_balance(void)
 int main(int argc, char **argv)
 {
     if (argc < 4) {
-        fprintf(stderr, "usage: test_mpi MPSFLOW TUTORIALS cases|restart|balance\n");
+        fprintf(stderr, "usage: test_mpi MPSFLOW TUTORIALS cases|restart|balance|bodies\n");
         return 2;
     }
     exe = argv[1];
@@ -514,6 +646,8 @@ int main(int argc, char **argv)
         part_restart();
     else if (!strcmp(argv[3], "balance"))
         part_balance();
+    else if (!strcmp(argv[3], "bodies"))
+        part_bodies();
     else
         return 2;
     return mf_test_summary(argv[3]);

@@ -328,6 +328,8 @@ int mps_source_terms(mps_data *d, const mf_sim *sim, double dt);
  * (explicit phase, lists at r^n), the pressure share (correction phase,
  * lists at r*). Nothing without a rigid body; a clear error where the
  * step's sums do not split over pairs or on several ranks. */
+/* The bodies' WallId field into the halo copies (after mps_halo_create). */
+int mps_bodies_halo(mps_data *d, const mf_sim *sim);
 void mps_bodies_begin(mps_data *d, mf_sim *sim);
 int mps_bodies_viscous(mps_data *d, mf_sim *sim);
 int mps_bodies_pressure(mps_data *d, mf_sim *sim, const double *pressure);
