@@ -32,6 +32,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "body_cases.h"
 #include "case_util.h"
 #include "mf_test.h"
 
@@ -631,28 +632,21 @@ typedef struct body_spec {
     const char *tag;
     long steps;
     const char *solver, *fluids, *geometry, *decompose; /* NULL: the tutorial's, none */
+    void (*make_geometry)(char *out, size_t len); /* when geometry is NULL */
     body_check bodies[2];
 } body_spec;
+
+/* test_bodies' momentum case, moving at 0.05 m/s (tests/body_cases.h). */
+static void momentum_geometry(char *out, size_t len)
+{
+    tc_momentum_geometry(out, len, 0.01, 0.05);
+}
 
 static const char *const water_fluids = "water { rho 1000; nu 1e-4; }\n";
 
 static const body_spec body_specs[] = {
-    {{NULL, 0, 1e-3, "", false, NULL}, "momentum", 100,
-     "solver MPS;\n"
-     "MPSCoeffs { gradient corrected; laplacian paper; collision no; shifting none; }\n"
-     "pressure { solver PCG_BoomerAMG; tolerance 1e-10; }\n",
-     NULL,
-     "dimension 2;\nparticleSpacing 0.01;\n"
-     "fluidBlocks {\n"
-     " a { type box; min (0.1 0.1 0); max (0.17 0.3 0); fluid water; }\n"
-     " b { type box; min (0.23 0.1 0); max (0.3 0.3 0); fluid water; }\n"
-     " c { type box; min (0.17 0.1 0); max (0.23 0.17 0); fluid water; }\n"
-     " d { type box; min (0.17 0.23 0); max (0.23 0.3 0); fluid water; }\n}\n"
-     "walls { tank { type box; min (0 0 0); max (0.4 0.4 0); } }\n"
-     "obstacles { body { type box; min (0.17 0.17 0); max (0.23 0.23 0);\n"
-     " motion { type rigid; density 1000; g (0 0 0); velocity (0.05 0 0); } } }\n",
-     NULL,
-     {{"body", NAN, 0.045}, {NULL, 0, 0}}},
+    {{NULL, 0, 1e-3, "", false, NULL}, "momentum", 100, TC_MOMENTUM_SOLVER, NULL, NULL, NULL,
+     momentum_geometry, {{"body", NAN, 0.045}, {NULL, 0, 0}}},
     {{NULL, 0, 1e-3, "", false, NULL}, "contact", 250,
      "solver MPS;\npressure { solver PCG_BoomerAMG; tolerance 1e-8; }\n",
      NULL,
@@ -664,12 +658,12 @@ static const body_spec body_specs[] = {
      "  motion { type rigid; density 500; g (0 -9.81 0); } }\n"
      " upper { type box; min (0.2 0.25 0); max (0.4 0.3 0);\n"
      "  motion { type rigid; density 500; g (0 -9.81 0); } } }\n",
-     "multiCriteria no;\n",
+     "multiCriteria no;\n", NULL,
      {{"lower", 0.025, 0.05}, {"upper", 0.075, 0.05}}},
     {{"waterEntry", 0.011, 2.5e-4, "", false, NULL}, "waterEntry", 120,
      "solver MPS;\npressure { solver PCG_BoomerAMG; tolerance 1e-12; }\n"
      "forces { gravity { g (0 -9.81 0); } }\n",
-     NULL, NULL, NULL,
+     NULL, NULL, NULL, NULL,
      {{"cylinder", NAN, 1.5}, {NULL, 0, 0}}},
     {{NULL, 0, 1e-3, "", false, NULL}, "floating3D", 50,
      "solver MPS;\npressure { solver PCG_BoomerAMG; tolerance 1e-8; }\n"
@@ -683,7 +677,7 @@ static const body_spec body_specs[] = {
      "  motion { type rigid; density 500; g (0 -9.81 0); } }\n"
      " ball { type sphere; centre (0.22 0.14 0.1); radius 0.04;\n"
      "  motion { type rigid; density 500; g (0 -9.81 0); } } }\n",
-     NULL,
+     NULL, NULL,
      {{"box", NAN, 0.4}, {"ball", NAN, 0.4}}},
 };
 
@@ -693,7 +687,11 @@ static int make_body_case(tc_case *c, const body_spec *bs, const char *tag)
     if (bs->cs.name) {
         rc = make_case(c, &bs->cs, tag, bs->steps, bs->steps);
     } else {
-        rc = tc_case_from_strings(c, exe, tag, NULL, NULL, water_fluids, bs->geometry);
+        char geometry[2048];
+        if (!bs->geometry)
+            bs->make_geometry(geometry, sizeof geometry);
+        rc = tc_case_from_strings(c, exe, tag, NULL, NULL, water_fluids,
+                                  bs->geometry ? bs->geometry : geometry);
         rc = rc != 0 ? rc : write_control(c, bs->cs.dt, bs->steps, bs->steps, NULL);
     }
     if (rc == 0 && bs->solver)
