@@ -278,7 +278,7 @@ static int copy_matrix(mf_split_csr *s, hypre_ParCSRMatrix *A)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory copying a level of %d rows", n);
     for (HYPRE_Int i = 0; i <= n; i++)
         rp[i] = (size_t)I[i];
-    const mf_csr c = {(size_t)n, 0, n, rp, hypre_CSRMatrixJ(D), hypre_CSRMatrixData(D)};
+    const mf_csr c = {(size_t)n, 0, n, rp, hypre_CSRMatrixJ(D), hypre_CSRMatrixData(D), 0};
     int rc = mf_split_csr_set(s, &c);
     free(rp);
     return rc;
