@@ -781,15 +781,6 @@ static void test_split_layout(void)
     CHECK_MSG(bad == 0, "the split layout differs from the rows in %zu places", bad);
     CHECK(sp.ptr[18] - sp.ptr[17] == N - 1); /* the long row: every column but its own */
     mf_split_csr_free(&sp);
-    /* Lent, but rows with their diagonal last and twice: a copy, the rows
-     * untouched. */
-    int32_t *col0 = malloc(k * sizeof *col0);
-    memcpy(col0, col, k * sizeof *col0);
-    A.lent_capacity = k;
-    CHECK_OK(mf_split_csr_fine(&sp, &A));
-    CHECK(sp.gap == 0 && memcmp(col0, col, k * sizeof *col0) == 0);
-    mf_split_csr_free(&sp);
-    free(col0);
     free(col);
     free(val);
 }

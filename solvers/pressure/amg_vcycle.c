@@ -120,10 +120,24 @@ static int64_t split_row_mid(const int32_t *col, size_t begin, size_t end, int32
     return e == end ? (int64_t)mid : -1;
 }
 
+/* Whether every row of A has its diagonal first and only there. */
+static bool diagonal_leads(const mf_csr *A)
+{
+    const size_t *rp = A->rowptr;
+    for (size_t i = 0; i < A->nrows; i++) {
+        if (rp[i + 1] <= rp[i] || A->col[rp[i]] != (int32_t)i)
+            return false;
+        for (size_t k = rp[i] + 1; k < rp[i + 1]; k++)
+            if (A->col[k] == (int32_t)i)
+                return false;
+    }
+    return true;
+}
+
 /* Room for the in-place split's bits and one row. */
 static int split_reserve_lent(mf_split_csr *s, size_t nnz, size_t longest)
 {
-    const size_t words = nnz / 64 + 2;
+    const size_t words = nnz / 64 + 1;
     if (words > s->cap_upper) {
         uint64_t *u = realloc(s->upper, words * sizeof *u);
         if (u == NULL)
@@ -145,50 +159,51 @@ static int split_reserve_lent(mf_split_csr *s, size_t nnz, size_t longest)
     return 0;
 }
 
-/* Bit k of the upper marks (set: entry k, counted from the matrix's first,
- * is above the diagonal). */
-static inline bool is_upper(const uint64_t *upper, size_t k)
+/* Row i's off-diagonal entries [b, e) of A: lower ones first, then upper
+ * ones, each in their order; bit (k - off) of s->upper for entry k set
+ * when it is upper. Returns where the upper ones start. */
+static size_t split_row_in_place(mf_split_csr *s, const mf_csr *A, size_t b, size_t e,
+                                 int32_t i, size_t off)
 {
-    return (upper[k / 64] >> (k % 64)) & 1;
-}
-
-/* Row i's off-diagonal entries [b, e) of A (relative to col, val): lower
- * ones first, then upper ones, each in their order, the marks set. Returns
- * where the upper ones start; *twice set when the diagonal was among them. */
-static int64_t split_row_in_place(mf_split_csr *s, int32_t *col, double *val, size_t b,
-                                  size_t e, int32_t i, bool *twice)
-{
+    int32_t *col = A->col;
+    double *val = A->val;
     size_t w = b, nu = 0;
     for (size_t k = b; k < e; k++) {
-        const int32_t c = col[k];
-        *twice |= c == i;
-        if (c < i) {
-            s->upper[k / 64] &= ~(UINT64_C(1) << (k % 64));
-            col[w] = c;
+        const size_t bit = k - off;
+        if (col[k] < i) {
+            s->upper[bit / 64] &= ~(UINT64_C(1) << (bit % 64));
+            col[w] = col[k];
             val[w++] = val[k];
         } else {
-            s->upper[k / 64] |= UINT64_C(1) << (k % 64);
-            s->row_buf[nu] = c;
+            s->upper[bit / 64] |= UINT64_C(1) << (bit % 64);
+            s->row_buf[nu] = col[k];
             s->row_val[nu++] = val[k];
         }
     }
     memcpy(col + w, s->row_buf, nu * sizeof *col);
     memcpy(val + w, s->row_val, nu * sizeof *val);
-    return (int64_t)w;
+    return w;
 }
 
 /* split_row_in_place's inverse. */
-static void merge_row_in_place(mf_split_csr *s, int32_t *col, double *val, size_t b, size_t mid,
-                               size_t e)
+static void merge_row_in_place(mf_split_csr *s, const mf_csr *A, size_t b, size_t e, size_t off)
 {
+    int32_t *col = A->col;
+    double *val = A->val;
+    size_t nl = 0;
+    for (size_t k = b; k < e; k++) {
+        const size_t bit = k - off;
+        nl += !((s->upper[bit / 64] >> (bit % 64)) & 1);
+    }
     /* The upper ones aside, then lower ones moved back to their places from
      * the end (a lower entry only moves right), the upper ones between. */
-    const size_t nu = e - mid;
-    memcpy(s->row_buf, col + mid, nu * sizeof *col);
-    memcpy(s->row_val, val + mid, nu * sizeof *val);
-    size_t lo = mid, up = nu;
+    const size_t nu = e - b - nl;
+    memcpy(s->row_buf, col + b + nl, nu * sizeof *col);
+    memcpy(s->row_val, val + b + nl, nu * sizeof *val);
+    size_t lo = b + nl, up = nu;
     for (size_t k = e; k-- > b;) {
-        if (is_upper(s->upper, k)) {
+        const size_t bit = k - off;
+        if ((s->upper[bit / 64] >> (bit % 64)) & 1) {
             up--;
             col[k] = s->row_buf[up];
             val[k] = s->row_val[up];
@@ -206,41 +221,9 @@ void mf_split_csr_restore(mf_split_csr *s)
     if (A == NULL)
         return;
     const size_t *rp = A->rowptr;
-    const size_t k0 = rp[0];
     for (size_t i = 0; i < A->nrows; i++)
-        merge_row_in_place(s, A->col + k0, A->val + k0, rp[i] + 1 - k0, (size_t)s->mid[i],
-                           rp[i + 1] - k0);
+        merge_row_in_place(s, A, rp[i] + 1, rp[i + 1], rp[0]);
     s->lent = NULL;
-}
-
-/* Split A's rows in its lent arrays; false (A as it was) when a row does
- * not lead with its diagonal or holds it twice. */
-static bool split_lent(mf_split_csr *s, const mf_csr *A)
-{
-    const size_t *rp = A->rowptr;
-    const size_t k0 = rp[0];
-    int32_t *col = A->col + k0;
-    double *val = A->val + k0;
-    for (size_t i = 0; i < A->nrows; i++) {
-        const size_t b = rp[i] - k0, e = rp[i + 1] - k0;
-        bool twice = false;
-        int64_t mid = b < e && col[b] == (int32_t)i
-                          ? split_row_in_place(s, col, val, b + 1, e, (int32_t)i, &twice)
-                          : -1;
-        if (twice) { /* a second diagonal entry: this row back first */
-            s->mid[i] = (int32_t)mid;
-            merge_row_in_place(s, col, val, b + 1, (size_t)mid, e);
-            mid = -1;
-        }
-        if (mid < 0) {
-            for (size_t r = 0; r < i; r++)
-                merge_row_in_place(s, col, val, rp[r] + 1 - k0, (size_t)s->mid[r],
-                                   rp[r + 1] - k0);
-            return false;
-        }
-        s->mid[i] = (int32_t)mid;
-    }
-    return true;
 }
 
 int mf_split_csr_fine(mf_split_csr *s, const mf_csr *A)
@@ -252,28 +235,24 @@ int mf_split_csr_fine(mf_split_csr *s, const mf_csr *A)
         return mf_split_csr_set(s, A);
     const size_t *rp = A->rowptr;
     const size_t k0 = rp[0];
-    /* Split in the lent arrays; else a view when the rows are already
-     * split, or a copy. */
-    bool lent = false;
-    if (A->lent_capacity > 0) {
+    /* Already split: a view. Else split in the lent arrays, or a copy. */
+    bool split = true;
+    for (size_t i = 0; i < n && split; i++)
+        split = split_row_mid(A->col, rp[i], rp[i + 1], (int32_t)i) >= 0;
+    if (!split) {
+        if (A->lent_capacity == 0 || !diagonal_leads(A))
+            return mf_split_csr_set(s, A);
         size_t longest = 0;
         for (size_t i = 0; i < n; i++)
             if (rp[i + 1] - rp[i] > longest)
                 longest = rp[i + 1] - rp[i];
         MF_CALL(split_reserve_lent(s, nnz, longest));
         MF_CALL(split_reserve(s, n, 0));
-        lent = split_lent(s, A);
-    }
-    if (!lent) {
         for (size_t i = 0; i < n; i++)
-            if (split_row_mid(A->col, rp[i], rp[i + 1], (int32_t)i) < 0)
-                return mf_split_csr_set(s, A);
+            split_row_in_place(s, A, rp[i] + 1, rp[i + 1], (int32_t)i, k0);
+        s->lent = A;
+    } else
         MF_CALL(split_reserve(s, n, 0));
-        for (size_t i = 0; i < n; i++)
-            s->mid[i] = (int32_t)(split_row_mid(A->col, rp[i], rp[i + 1], (int32_t)i) -
-                                  (int64_t)k0);
-    }
-    s->lent = lent ? A : NULL;
     s->col = A->col + k0;
     s->val = A->val + k0;
     s->gap = 1;
@@ -281,6 +260,7 @@ int mf_split_csr_fine(mf_split_csr *s, const mf_csr *A)
         /* the copy's diagonal: 0 + the one entry (the same bits but for a -0) */
         const double d = 0.0 + A->val[rp[i]];
         s->ptr[i] = (int32_t)(rp[i] - k0 + 1);
+        s->mid[i] = (int32_t)(split_row_mid(A->col, rp[i], rp[i + 1], (int32_t)i) - (int64_t)k0);
         s->diag[i] = d;
         s->dinv[i] = d != 0.0 ? 1.0 / d : 0.0;
     }
