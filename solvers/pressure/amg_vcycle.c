@@ -120,139 +120,19 @@ static int64_t split_row_mid(const int32_t *col, size_t begin, size_t end, int32
     return e == end ? (int64_t)mid : -1;
 }
 
-/* Whether every row of A has its diagonal first and only there. */
-static bool diagonal_leads(const mf_csr *A)
-{
-    const size_t *rp = A->rowptr;
-    for (size_t i = 0; i < A->nrows; i++) {
-        if (rp[i + 1] <= rp[i] || A->col[rp[i]] != (int32_t)i)
-            return false;
-        for (size_t k = rp[i] + 1; k < rp[i + 1]; k++)
-            if (A->col[k] == (int32_t)i)
-                return false;
-    }
-    return true;
-}
-
-/* Room for the in-place split's bits and one row. */
-static int split_reserve_lent(mf_split_csr *s, size_t nnz, size_t longest)
-{
-    const size_t words = nnz / 64 + 1;
-    if (words > s->cap_upper) {
-        uint64_t *u = realloc(s->upper, words * sizeof *u);
-        if (u == NULL)
-            return MF_ERROR(MF_ERR_MEMORY, "out of memory splitting %zu non-zeros", nnz);
-        s->upper = u;
-        s->cap_upper = words;
-    }
-    if (longest + 1 > s->cap_row) {
-        int32_t *c = realloc(s->row_buf, (longest + 1) * sizeof *c);
-        if (c)
-            s->row_buf = c;
-        double *v = realloc(s->row_val, (longest + 1) * sizeof *v);
-        if (v)
-            s->row_val = v;
-        if (!c || !v)
-            return MF_ERROR(MF_ERR_MEMORY, "out of memory for a row of %zu entries", longest);
-        s->cap_row = longest + 1;
-    }
-    return 0;
-}
-
-/* Row i's off-diagonal entries [b, e) of A: lower ones first, then upper
- * ones, each in their order; bit (k - off) of s->upper for entry k set
- * when it is upper. Returns where the upper ones start. */
-static size_t split_row_in_place(mf_split_csr *s, const mf_csr *A, size_t b, size_t e,
-                                 int32_t i, size_t off)
-{
-    int32_t *col = A->col;
-    double *val = A->val;
-    size_t w = b, nu = 0;
-    for (size_t k = b; k < e; k++) {
-        const size_t bit = k - off;
-        if (col[k] < i) {
-            s->upper[bit / 64] &= ~(UINT64_C(1) << (bit % 64));
-            col[w] = col[k];
-            val[w++] = val[k];
-        } else {
-            s->upper[bit / 64] |= UINT64_C(1) << (bit % 64);
-            s->row_buf[nu] = col[k];
-            s->row_val[nu++] = val[k];
-        }
-    }
-    memcpy(col + w, s->row_buf, nu * sizeof *col);
-    memcpy(val + w, s->row_val, nu * sizeof *val);
-    return w;
-}
-
-/* split_row_in_place's inverse. */
-static void merge_row_in_place(mf_split_csr *s, const mf_csr *A, size_t b, size_t e, size_t off)
-{
-    int32_t *col = A->col;
-    double *val = A->val;
-    size_t nl = 0;
-    for (size_t k = b; k < e; k++) {
-        const size_t bit = k - off;
-        nl += !((s->upper[bit / 64] >> (bit % 64)) & 1);
-    }
-    /* The upper ones aside, then lower ones moved back to their places from
-     * the end (a lower entry only moves right), the upper ones between. */
-    const size_t nu = e - b - nl;
-    memcpy(s->row_buf, col + b + nl, nu * sizeof *col);
-    memcpy(s->row_val, val + b + nl, nu * sizeof *val);
-    size_t lo = b + nl, up = nu;
-    for (size_t k = e; k-- > b;) {
-        const size_t bit = k - off;
-        if ((s->upper[bit / 64] >> (bit % 64)) & 1) {
-            up--;
-            col[k] = s->row_buf[up];
-            val[k] = s->row_val[up];
-        } else {
-            lo--;
-            col[k] = col[lo];
-            val[k] = val[lo];
-        }
-    }
-}
-
-void mf_split_csr_restore(mf_split_csr *s)
-{
-    const mf_csr *A = s->lent;
-    if (A == NULL)
-        return;
-    const size_t *rp = A->rowptr;
-    for (size_t i = 0; i < A->nrows; i++)
-        merge_row_in_place(s, A, rp[i] + 1, rp[i + 1], rp[0]);
-    s->lent = NULL;
-}
-
 int mf_split_csr_fine(mf_split_csr *s, const mf_csr *A)
 {
     const size_t n = A->nrows;
     const size_t nnz = n > 0 ? A->rowptr[n] - A->rowptr[0] : 0;
-    s->lent = NULL;
     if (n == 0 || n > INT32_MAX || nnz >= INT32_MAX)
         return mf_split_csr_set(s, A);
     const size_t *rp = A->rowptr;
     const size_t k0 = rp[0];
-    /* Already split: a view. Else split in the lent arrays, or a copy. */
-    bool split = true;
-    for (size_t i = 0; i < n && split; i++)
-        split = split_row_mid(A->col, rp[i], rp[i + 1], (int32_t)i) >= 0;
-    if (!split) {
-        if (A->lent_capacity == 0 || !diagonal_leads(A))
+    /* Look first: a row that is not in the view's order makes it a copy. */
+    for (size_t i = 0; i < n; i++)
+        if (split_row_mid(A->col, rp[i], rp[i + 1], (int32_t)i) < 0)
             return mf_split_csr_set(s, A);
-        size_t longest = 0;
-        for (size_t i = 0; i < n; i++)
-            if (rp[i + 1] - rp[i] > longest)
-                longest = rp[i + 1] - rp[i];
-        MF_CALL(split_reserve_lent(s, nnz, longest));
-        MF_CALL(split_reserve(s, n, 0));
-        for (size_t i = 0; i < n; i++)
-            split_row_in_place(s, A, rp[i] + 1, rp[i + 1], (int32_t)i, k0);
-        s->lent = A;
-    } else
-        MF_CALL(split_reserve(s, n, 0));
+    MF_CALL(split_reserve(s, n, 0));
     s->col = A->col + k0;
     s->val = A->val + k0;
     s->gap = 1;
@@ -271,10 +151,6 @@ int mf_split_csr_fine(mf_split_csr *s, const mf_csr *A)
 
 void mf_split_csr_free(mf_split_csr *s)
 {
-    mf_split_csr_restore(s);
-    free(s->upper);
-    free(s->row_buf);
-    free(s->row_val);
     free(s->ptr);
     free(s->mid);
     free(s->col_buf);
@@ -611,15 +487,12 @@ static int pcg_run(mf_amg_vcycle *v, const mf_csr *A_in, const int64_t *prow, do
             rr += r[i] * r[i];
         }
         if (rr <= stop2) {
-            /* Tentatively converged: decide on the true residual (from
-             * the caller's rows, in their order). */
-            mf_split_csr_restore(&v->fine);
+            /* Tentatively converged: decide on the true residual. */
             const double t = resid(ctx, x, r);
             if (t <= stop) {
                 *rel = t / bnorm;
                 return 0;
             }
-            MF_CALL(mf_split_csr_fine(&v->fine, A_in));
         }
         mf_amg_vcycle_apply(v, A, prow, r, z);
         double g = 0.0;
@@ -630,7 +503,6 @@ static int pcg_run(mf_amg_vcycle *v, const mf_csr *A_in, const int64_t *prow, do
         for (size_t i = 0; i < n; i++)
             p[i] = z[i] + beta * p[i];
     }
-    mf_split_csr_restore(&v->fine);
     *rel = resid(ctx, x, r) / bnorm;
     return MF_RETRY;
 }
@@ -641,8 +513,7 @@ int mf_amg_pcg(mf_amg_vcycle *v, const mf_csr *A, const int64_t *prow, double *x
 {
     int rc = pcg_run(v, A, prow, x, r, bnorm, tol, max_iter, resid, ctx, iterations, rel);
     /* The fine level's copy goes with the solve: kept, it would sit beside
-     * the next step's matrix while that is assembled (peak memory). A split
-     * in the caller's arrays is undone first (mf_split_csr_free). */
+     * the next step's matrix while that is assembled (peak memory). */
     mf_split_csr_free(&v->fine);
     return rc;
 }
