@@ -437,6 +437,53 @@ static void masked_system(int n, int t, bool renumber, poisson *p, int64_t *slot
     free(row);
 }
 
+/* A matrix that lends its arrays (mf_csr.lent_capacity: the AMG set-up's
+ * fine matrix made in them, fine_in_place.c) is solved exactly as one that
+ * does not, bit for bit, and comes back as it was. One rank (the in-place
+ * set-up is our V-cycle's). */
+static void test_lent_rows(void)
+{
+    if (nprocs != 1)
+        return;
+    const int n = 48;
+    int64_t *slot = malloc((size_t)n * n * sizeof *slot), nslots = 0;
+    for (int t = 0; t < 12; t += 5) {
+        poisson p, q;
+        mf_pcg_boomeramg_settings s;
+        defaults(&mf_pressure_PCG_BoomerAMG, &s);
+        void *a = NULL, *b = NULL;
+        CHECK_OK(mf_pressure_PCG_BoomerAMG.create(&s, &a));
+        CHECK_OK(mf_pressure_PCG_BoomerAMG.create(&s, &b));
+        masked_system(n, t, false, &p, slot, &nslots);
+        masked_system(n, t, false, &q, slot, &nslots);
+        const mf_row_names rows = {slot, nslots, 1};
+        const size_t nnz = q.A.rowptr[q.A.nrows];
+        q.A.lent_capacity = 5 * (size_t)nslots + 1; /* masked_system's room */
+        CHECK(nnz + (size_t)nslots - q.A.nrows <= q.A.lent_capacity);
+        for (size_t k = nnz; k < q.A.lent_capacity; k++)
+            q.A.val[k] = NAN; /* the room: written only if the arrays were used */
+        mf_solve_report rp, rq;
+        CHECK_OK(mf_pressure_PCG_BoomerAMG.solve_rows(a, &p.A, &rows, p.b, p.x, &rp));
+        CHECK_OK(mf_pressure_PCG_BoomerAMG.solve_rows(b, &q.A, &rows, q.b, q.x, &rq));
+        CHECK_MSG(rp.iterations == rq.iterations &&
+                      memcmp(p.x, q.x, p.A.nrows * sizeof *p.x) == 0,
+                  "band at %d: lent rows solved differently (%d against %d iterations)", t,
+                  rq.iterations, rp.iterations);
+        CHECK_MSG(memcmp(p.A.col, q.A.col, nnz * sizeof *p.A.col) == 0 &&
+                      memcmp(p.A.val, q.A.val, nnz * sizeof *p.A.val) == 0,
+                  "band at %d: the lent rows did not come back as they were", t);
+        size_t used = 0;
+        for (size_t k = nnz; k < q.A.lent_capacity; k++)
+            used += !isnan(q.A.val[k]);
+        CHECK_MSG(used > 0, "band at %d: the lent arrays were not used for the set-up", t);
+        mf_pressure_PCG_BoomerAMG.destroy(a);
+        mf_pressure_PCG_BoomerAMG.destroy(b);
+        poisson_free(&p);
+        poisson_free(&q);
+    }
+    free(slot);
+}
+
 static void test_named_rows(void)
 {
     const int n = 64;
@@ -864,6 +911,7 @@ int main(int argc, char **argv)
     test_warm_start(&mf_pressure_PCG_diagonal, &ds);
     test_reuse();
     test_named_rows();
+    test_lent_rows();
     test_own_vcycle();
     test_split_layout();
     test_split_view();
