@@ -437,6 +437,53 @@ static void masked_system(int n, int t, bool renumber, poisson *p, int64_t *slot
     free(row);
 }
 
+/* A matrix that lends its arrays (mf_csr.lent_capacity: the AMG set-up's
+ * fine matrix made in them, fine_in_place.c) is solved exactly as one that
+ * does not, bit for bit, and comes back as it was. One rank (the in-place
+ * set-up is our V-cycle's). */
+static void test_lent_rows(void)
+{
+    if (nprocs != 1)
+        return;
+    const int n = 48;
+    int64_t *slot = malloc((size_t)n * n * sizeof *slot), nslots = 0;
+    for (int t = 0; t < 12; t += 5) {
+        poisson p, q;
+        mf_pcg_boomeramg_settings s;
+        defaults(&mf_pressure_PCG_BoomerAMG, &s);
+        void *a = NULL, *b = NULL;
+        CHECK_OK(mf_pressure_PCG_BoomerAMG.create(&s, &a));
+        CHECK_OK(mf_pressure_PCG_BoomerAMG.create(&s, &b));
+        masked_system(n, t, false, &p, slot, &nslots);
+        masked_system(n, t, false, &q, slot, &nslots);
+        const mf_row_names rows = {slot, nslots, 1};
+        const size_t nnz = q.A.rowptr[q.A.nrows];
+        q.A.lent_capacity = 5 * (size_t)nslots + 1; /* masked_system's room */
+        CHECK(nnz + (size_t)nslots - q.A.nrows <= q.A.lent_capacity);
+        for (size_t k = nnz; k < q.A.lent_capacity; k++)
+            q.A.val[k] = NAN; /* the room: written only if the arrays were used */
+        mf_solve_report rp, rq;
+        CHECK_OK(mf_pressure_PCG_BoomerAMG.solve_rows(a, &p.A, &rows, p.b, p.x, &rp));
+        CHECK_OK(mf_pressure_PCG_BoomerAMG.solve_rows(b, &q.A, &rows, q.b, q.x, &rq));
+        CHECK_MSG(rp.iterations == rq.iterations &&
+                      memcmp(p.x, q.x, p.A.nrows * sizeof *p.x) == 0,
+                  "band at %d: lent rows solved differently (%d against %d iterations)", t,
+                  rq.iterations, rp.iterations);
+        CHECK_MSG(memcmp(p.A.col, q.A.col, nnz * sizeof *p.A.col) == 0 &&
+                      memcmp(p.A.val, q.A.val, nnz * sizeof *p.A.val) == 0,
+                  "band at %d: the lent rows did not come back as they were", t);
+        size_t used = 0;
+        for (size_t k = nnz; k < q.A.lent_capacity; k++)
+            used += !isnan(q.A.val[k]);
+        CHECK_MSG(used > 0, "band at %d: the lent arrays were not used for the set-up", t);
+        mf_pressure_PCG_BoomerAMG.destroy(a);
+        mf_pressure_PCG_BoomerAMG.destroy(b);
+        poisson_free(&p);
+        poisson_free(&q);
+    }
+    free(slot);
+}
+
 static void test_named_rows(void)
 {
     const int n = 64;
@@ -655,6 +702,63 @@ static void test_own_vcycle(void)
     omp_set_num_threads(saved_threads);
 }
 
+/* The view of rows already split (the diagonal, then lower columns, then
+ * upper ones in order: the MPS rows) reads the CSR in place and holds what
+ * the copy holds; one row out of that order makes it a copy. */
+static void test_split_view(void)
+{
+    enum { N = 300, W = 7 };
+    size_t rowptr[N + 1];
+    int32_t col[N * (2 * W + 1)];
+    double val[N * (2 * W + 1)];
+    size_t k = 0;
+    for (int i = 0; i < N; i++) {
+        rowptr[i] = k;
+        col[k] = i;
+        val[k++] = 10.0 + (double)(i % 5);
+        for (int j = i - W; j <= i + W; j++)
+            if (j >= 0 && j < N && j != i && (i * 31 + j * 17) % 3 != 0) {
+                col[k] = j;
+                val[k++] = -1.0 / (1.0 + (double)((i + 2 * j) % 11));
+            }
+    }
+    rowptr[N] = k;
+    mf_csr A = {.nrows = N, .nglobal = N, .rowptr = rowptr, .col = col, .val = val};
+    mf_split_csr copy = {0}, view = {0};
+    CHECK_OK(mf_split_csr_set(&copy, &A));
+    CHECK_OK(mf_split_csr_fine(&view, &A));
+    CHECK_MSG(view.gap == 1 && view.col == col && view.val == val,
+              "rows already split: the view should read them in place");
+    size_t bad = 0;
+    for (int32_t i = 0; i < N; i++) {
+        const int32_t len = mf_split_end(&copy, i) - copy.ptr[i];
+        bad += mf_split_end(&view, i) - view.ptr[i] != len ||
+               view.mid[i] - view.ptr[i] != copy.mid[i] - copy.ptr[i] ||
+               view.diag[i] != copy.diag[i] || view.dinv[i] != copy.dinv[i];
+        for (int32_t e = 0; e < len && bad == 0; e++)
+            bad += view.col[view.ptr[i] + e] != copy.col[copy.ptr[i] + e] ||
+                   view.val[view.ptr[i] + e] != copy.val[copy.ptr[i] + e];
+    }
+    CHECK_MSG(bad == 0, "the view differs from the copy in %zu rows", bad);
+    double p[N], q1[N], q2[N];
+    for (int i = 0; i < N; i++)
+        p[i] = sin(0.1 * i);
+    const double d1 = mf_split_csr_matvec_dot(&copy, p, q1);
+    const double d2 = mf_split_csr_matvec_dot(&view, p, q2);
+    CHECK(d1 == d2 && memcmp(q1, q2, sizeof q1) == 0);
+    /* Row 5 with an upper column before a lower one: a copy. */
+    const size_t r5 = rowptr[5] + 1, last = rowptr[6] - 1;
+    CHECK(col[r5] < 5 && col[last] > 5);
+    int32_t c = col[r5];
+    col[r5] = col[last];
+    col[last] = c;
+    mf_split_csr_free(&view);
+    CHECK_OK(mf_split_csr_fine(&view, &A));
+    CHECK_MSG(view.gap == 0 && view.col != col, "a row out of order must make a copy");
+    mf_split_csr_free(&view);
+    mf_split_csr_free(&copy);
+}
+
 /* The fingerprint that decides reuse: blind to values, not to the pattern. */
 /* The split layout of rows in any column order, a diagonal given twice and
  * a row longer than the one-pass stage: lower entries then upper ones, each
@@ -807,8 +911,10 @@ int main(int argc, char **argv)
     test_warm_start(&mf_pressure_PCG_diagonal, &ds);
     test_reuse();
     test_named_rows();
+    test_lent_rows();
     test_own_vcycle();
     test_split_layout();
+    test_split_view();
     test_pattern_hash();
     test_bad_input();
 

@@ -56,6 +56,11 @@ typedef struct mf_csr {
     size_t *rowptr;   /* nrows + 1 */
     int32_t *col;     /* rowptr[nrows] */
     double *val;      /* rowptr[nrows] */
+    /* > 0: the caller lends col and val (room for lent_capacity entries from
+     * index 0) to the solve, which may rearrange them while it runs and puts
+     * them back, bit for bit, before it returns (solvers/pressure/
+     * fine_in_place.c: hypre's fine matrix made in them); 0: read only. */
+    size_t lent_capacity;
 } mf_csr;
 #define MF_CSR_MAX_GLOBAL INT32_MAX
 

@@ -45,13 +45,13 @@ static int split_reserve(mf_split_csr *s, size_t n, size_t nnz)
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for a matrix of %zu rows", n);
         s->cap_rows = n;
     }
-    if (nnz > s->cap_nnz || s->col == NULL) {
-        int32_t *col = realloc(s->col, (nnz + 1) * sizeof *col);
+    if (nnz > s->cap_nnz || s->col_buf == NULL) {
+        int32_t *col = realloc(s->col_buf, (nnz + 1) * sizeof *col);
         if (col)
-            s->col = col;
-        double *val = realloc(s->val, (nnz + 1) * sizeof *val);
+            s->col_buf = col;
+        double *val = realloc(s->val_buf, (nnz + 1) * sizeof *val);
         if (val)
-            s->val = val;
+            s->val_buf = val;
         if (!col || !val)
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for a matrix of %zu non-zeros", nnz);
         s->cap_nnz = nnz;
@@ -67,6 +67,11 @@ int mf_split_csr_set(mf_split_csr *s, const mf_csr *A)
         return MF_ERROR(MF_ERR_INPUT, "a matrix of %zu rows and %zu non-zeros is too large for "
                         "32-bit indices", n, nnz);
     MF_CALL(split_reserve(s, n, nnz));
+    int32_t *scol = s->col_buf;
+    double *sval = s->val_buf;
+    s->col = scol;
+    s->val = sval;
+    s->gap = 0;
     const size_t *rp = A->rowptr;
     const size_t k0 = n > 0 ? rp[0] : 0;
     const int32_t *col = A->col + k0;
@@ -80,16 +85,16 @@ int mf_split_csr_set(mf_split_csr *s, const mf_csr *A)
             if (c == i)
                 d += val[e];
             else if (c < i) {
-                s->col[k] = c;
-                s->val[k++] = val[e];
+                scol[k] = c;
+                sval[k++] = val[e];
             }
         }
         s->mid[i] = k;
         for (size_t e = rp[i] - k0; e < rp[i + 1] - k0; e++) {
             const int32_t c = col[e];
             if (c > i) {
-                s->col[k] = c;
-                s->val[k++] = val[e];
+                scol[k] = c;
+                sval[k++] = val[e];
             }
         }
         s->ptr[i + 1] = k;
@@ -100,12 +105,56 @@ int mf_split_csr_set(mf_split_csr *s, const mf_csr *A)
     return 0;
 }
 
+/* Row i of A as the view wants it (its diagonal first and only there, then
+ * columns below i, then above): mid = where those above begin; -1 if not. */
+static int64_t split_row_mid(const int32_t *col, size_t begin, size_t end, int32_t i)
+{
+    if (begin == end || col[begin] != i)
+        return -1;
+    size_t e = begin + 1;
+    while (e < end && col[e] < i)
+        e++;
+    const size_t mid = e;
+    while (e < end && col[e] > i)
+        e++;
+    return e == end ? (int64_t)mid : -1;
+}
+
+int mf_split_csr_fine(mf_split_csr *s, const mf_csr *A)
+{
+    const size_t n = A->nrows;
+    const size_t nnz = n > 0 ? A->rowptr[n] - A->rowptr[0] : 0;
+    if (n == 0 || n > INT32_MAX || nnz >= INT32_MAX)
+        return mf_split_csr_set(s, A);
+    const size_t *rp = A->rowptr;
+    const size_t k0 = rp[0];
+    /* Look first: a row that is not in the view's order makes it a copy. */
+    for (size_t i = 0; i < n; i++)
+        if (split_row_mid(A->col, rp[i], rp[i + 1], (int32_t)i) < 0)
+            return mf_split_csr_set(s, A);
+    MF_CALL(split_reserve(s, n, 0));
+    s->col = A->col + k0;
+    s->val = A->val + k0;
+    s->gap = 1;
+    for (size_t i = 0; i < n; i++) {
+        /* the copy's diagonal: 0 + the one entry (the same bits but for a -0) */
+        const double d = 0.0 + A->val[rp[i]];
+        s->ptr[i] = (int32_t)(rp[i] - k0 + 1);
+        s->mid[i] = (int32_t)(split_row_mid(A->col, rp[i], rp[i + 1], (int32_t)i) - (int64_t)k0);
+        s->diag[i] = d;
+        s->dinv[i] = d != 0.0 ? 1.0 / d : 0.0;
+    }
+    s->ptr[n] = (int32_t)(rp[n] - k0 + 1);
+    s->n = (int32_t)n;
+    return 0;
+}
+
 void mf_split_csr_free(mf_split_csr *s)
 {
     free(s->ptr);
     free(s->mid);
-    free(s->col);
-    free(s->val);
+    free(s->col_buf);
+    free(s->val_buf);
     free(s->diag);
     free(s->dinv);
     memset(s, 0, sizeof *s);
@@ -117,7 +166,7 @@ double mf_split_csr_matvec_dot(const mf_split_csr *A, const double *p, double *q
     for (int32_t i = 0; i < A->n; i++) {
         const int32_t k = A->ptr[i];
         const double qi =
-            A->diag[i] * p[i] + mf_row_dot(A->col + k, A->val + k, (size_t)(A->ptr[i + 1] - k), p);
+            A->diag[i] * p[i] + mf_row_dot(A->col + k, A->val + k, (size_t)(mf_split_end(A, i) - k), p);
         q[i] = qi;
         pq += p[i] * qi;
     }
@@ -229,7 +278,7 @@ static int copy_matrix(mf_split_csr *s, hypre_ParCSRMatrix *A)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory copying a level of %d rows", n);
     for (HYPRE_Int i = 0; i <= n; i++)
         rp[i] = (size_t)I[i];
-    const mf_csr c = {(size_t)n, 0, n, rp, hypre_CSRMatrixJ(D), hypre_CSRMatrixData(D)};
+    const mf_csr c = {(size_t)n, 0, n, rp, hypre_CSRMatrixJ(D), hypre_CSRMatrixData(D), 0};
     int rc = mf_split_csr_set(s, &c);
     free(rp);
     return rc;
@@ -335,7 +384,7 @@ static void restrict_residual(const mf_split_csr *A, const amg_level *L, const i
     memset(fc, 0, (size_t)nc * sizeof *fc);
     for (int32_t i = 0; i < A->n; i++) {
         const int32_t m = A->mid[i];
-        const double res = -mf_row_dot(A->col + m, A->val + m, (size_t)(A->ptr[i + 1] - m), u);
+        const double res = -mf_row_dot(A->col + m, A->val + m, (size_t)(mf_split_end(A, i) - m), u);
         const int64_t pr = prow ? prow[i] : i;
         for (int32_t k = L->pptr[pr]; k < L->pptr[pr + 1]; k++)
             fc[L->pcol[k]] += L->pval[k] * res;
@@ -359,7 +408,7 @@ static void sweep_up(const mf_split_csr *A, const double *f, double *u)
     for (int32_t i = A->n - 1; i >= 0; i--) {
         const int32_t k = A->ptr[i];
         const double res = f[i] - A->diag[i] * u[i] -
-                           mf_row_dot(A->col + k, A->val + k, (size_t)(A->ptr[i + 1] - k), u);
+                           mf_row_dot(A->col + k, A->val + k, (size_t)(mf_split_end(A, i) - k), u);
         u[i] += res * A->dinv[i];
     }
 }
@@ -403,7 +452,7 @@ static int pcg_run(mf_amg_vcycle *v, const mf_csr *A_in, const int64_t *prow, do
         return MF_ERROR(MF_ERR_INTERNAL,
                         "a system of %zu rows for an AMG hierarchy set up for %d", n,
                         (int)v->lev[0].n);
-    MF_CALL(mf_split_csr_set(&v->fine, A_in));
+    MF_CALL(mf_split_csr_fine(&v->fine, A_in));
     const mf_split_csr *A = &v->fine;
     if (n > v->work_n) {
         for (int k = 0; k < 3; k++) {

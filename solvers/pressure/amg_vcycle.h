@@ -22,7 +22,9 @@
  *
  * The fine level is the caller's matrix of this solve (rows in row space,
  * each mapped to its row of the first interpolation by its slot), copied
- * into the split layout for the solve and freed after it; the coarse levels and interpolations
+ * into the split layout for the solve and freed after it (or, when its rows
+ * are already split, the diagonal first, read in place: mf_split_csr_fine);
+ * the coarse levels and interpolations
  * are copies of hypre's, taken right after the set-up, hypre's freed as
  * they are copied.
  */
@@ -36,20 +38,39 @@
 #include "mf_modules.h"
 
 /* A square matrix by rows, the diagonal apart: the off-diagonal entries of
- * row i are [ptr[i], ptr[i + 1]), those of columns below i first
- * ([ptr[i], mid[i])), then those above. */
+ * row i are [ptr[i], ptr[i + 1] - gap), those of columns below i first
+ * ([ptr[i], mid[i])), then those above. A copy (mf_split_csr_set) owns
+ * col and val and has gap 0; a view of a CSR whose rows are already split
+ * (mf_split_csr_fine) reads the CSR's own arrays, each row's leading
+ * diagonal entry the gap between one row's entries and the next's. */
 typedef struct mf_split_csr {
     int32_t n;
-    int32_t *ptr, *mid, *col;
-    double *val;
+    int32_t gap;
+    int32_t *ptr, *mid;
+    const int32_t *col;
+    const double *val;
     double *diag, *dinv; /* dinv[i] = 1 / diag[i] (0 for a zero diagonal) */
+    int32_t *col_buf;    /* a copy's own entries (col and val point here) */
+    double *val_buf;
     size_t cap_rows, cap_nnz;
 } mf_split_csr;
+
+/* End of row i's off-diagonal entries. */
+static inline int32_t mf_split_end(const mf_split_csr *s, int32_t i)
+{
+    return s->ptr[i + 1] - s->gap;
+}
 
 /* Copy a CSR of one rank (columns in [0, n), any order, the diagonal
  * anywhere in its row, duplicates summed into it) into the split layout,
  * growing s's arrays as needed. */
 int mf_split_csr_set(mf_split_csr *s, const mf_csr *A);
+/* The same layout without the copy when every row of A is its diagonal
+ * (once) followed by its lower entries, then its upper ones (the MPS
+ * pressure equation: neighbours in index order): s then reads A's col and
+ * val, which must outlive it; otherwise a copy (mf_split_csr_set). The
+ * values and their order are the copy's either way. */
+int mf_split_csr_fine(mf_split_csr *s, const mf_csr *A);
 void mf_split_csr_free(mf_split_csr *s);
 
 /* q = A p; returns p . q. */

@@ -551,9 +551,12 @@ int mf_hypre_setup_cycle(const char *who, HYPRE_Solver amg, const mf_csr *A,
     }
     const slot_space ss = {rows, 0, rows ? rows->nslots : 0, NULL}; /* one rank */
     rc = rows ? check_names(who, A, rows) : 0;
+    bool in_place = false; /* hypre's matrix in A's arrays: no copy of A */
     if (rc == 0)
+        rc = mf_hypre_setup_in_place(who, amg, A, rows, &in_place);
+    if (rc == 0 && !in_place)
         rc = assemble(who, A, &ss, zero, zero, &sys);
-    if (rc == 0) {
+    if (rc == 0 && !in_place) {
         HYPRE_Int ierr = HYPRE_BoomerAMGSetup(amg, sys.parA, sys.parb, sys.parx);
         if (ierr != 0)
             rc = mf_hypre_error(who, "HYPRE_BoomerAMGSetup", ierr, __FILE__, __LINE__, __func__);

@@ -115,6 +115,12 @@ int mf_boomeramg_create(const mf_pcg_boomeramg_settings *s, HYPRE_Solver *out);
 int mf_hypre_setup_cycle(const char *who, HYPRE_Solver amg, const mf_csr *A,
                          const mf_row_names *rows, mf_amg_vcycle **cycle);
 
+/* One rank: set amg up on A in slot space made in A's own arrays when A
+ * lends them (mf_csr.lent_capacity) and its rows allow it (fine_in_place.c);
+ * A is as it was on return. *done false (and 0): not possible, nothing done. */
+int mf_hypre_setup_in_place(const char *who, HYPRE_Solver amg, const mf_csr *A,
+                            const mf_row_names *rows, bool *done);
+
 /* A 64-bit fingerprint of the sizes, row range and sparsity pattern of this
  * rank's rows, agreed over all ranks (the same value everywhere). */
 int mf_hypre_pattern_hash(const mf_csr *A, uint64_t *hash);

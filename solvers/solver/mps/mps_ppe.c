@@ -243,6 +243,8 @@ static int ppe_sized(void *ctx, size_t nnz)
 {
     ppe_ctx *c = ctx;
     MF_CALL(reserve_system(c->d, c->d->A.nrows, nnz));
+    /* The pressure module may make its fine matrix in them (fine_in_place.c). */
+    c->d->A.lent_capacity = c->d->cap_nnz;
     c->rows.col = c->d->A.col;
     c->rows.val = c->d->A.val;
     c->rows.rowptr = c->d->A.rowptr;
