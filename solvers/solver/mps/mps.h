@@ -33,6 +33,7 @@ typedef struct mps_settings {
     double compressibility;   /* 1/Pa; adds rho c / dt^2 to the diagonal (0: off) */
     bool clip_negative_pressure;
     bool gradient_pmin;       /* eq. 5 with p_min (Koshizuka et al. 1998) */
+    bool wall_pressure_extrapolated; /* the gradient reads the walls' p from the fluid's (mps_wall_pressure.c) */
     /* The scheme (mps_scheme.c): a named set of the five choices below,
      * each of which a case may set apart ("scheme": the scheme's). */
     const char *scheme;       /* paper | robust | stabilised */
@@ -176,7 +177,7 @@ typedef struct mps_data {
 enum { MPS_FLAG_SURFACE = 1 }; /* bits of the Flags field */
 
 extern const mf_solver_ops mf_solver_MPS;
-#define MPS_NPARAMS 28 /* checked against the table in mps_params.c */
+#define MPS_NPARAMS 29 /* checked against the table in mps_params.c */
 extern const mf_param mps_params[MPS_NPARAMS];
 extern const char *const mps_viscosity_choices[]; /* explicit, implicit */
 extern const char *const mps_wall_choices[];      /* particles, wallWeight */
@@ -214,6 +215,10 @@ extern const char *const mps_scheme_choices[], *const mps_source_choices[],
     {"gradientPmin", MF_PARAM_BOOL, "yes", MF_NO_RANGE, NULL,                                   \
      OFF(gradient_pmin),                                                                        \
      "pressure gradient with p_min of the neighbourhood (eq. 5 note)"},                         \
+    {"wallPressureExtrapolated", MF_PARAM_BOOL, "no", MF_NO_RANGE, NULL,                        \
+     OFF(wall_pressure_extrapolated),                                                           \
+     "the pressure gradient takes the wall particles' pressure from their fluid neighbours' "   \
+     "(Adami, Hu & Adams 2012, eq. 27) instead of the PPE's (gradient paper, wall particles)"}, \
     {"scheme", MF_PARAM_WORD, SCHEME, MF_NO_RANGE, mps_scheme_choices, OFF(scheme),             \
      "the scheme: the defaults of source, gradient, laplacian, shifting, surfaceDetection "      \
      "and collision (paper: eqs. 5, 7, 14, 18 as printed; robust: mixed source, asymmetry "     \
@@ -428,6 +433,10 @@ void mps_wall_viscous(mps_data *d, const mf_sim *sim, double nu);              /
 void mps_wall_divergence(const mps_data *d, const mf_sim *sim, const uint8_t *imask,
                          double *div);
 /* Into d->grad; phat: p^ of eq. 5 (the neighbourhood's minimum or p). */
+/* Adami, Hu & Adams 2012's wall pressure (mps_wall_pressure.c): out = pressure,
+ * the wall particles' entries from their fluid neighbours in v. */
+void mps_wall_pressure_extrapolate(const mps_data *d, const mf_sim *sim, const mf_pairs *v,
+                                   const double *pressure, double *out);
 void mps_wall_gradient(const mps_data *d, const mf_sim *sim, const double *pressure,
                        const double *phat, double rho);
 int mps_wall_collide(mps_data *d, mf_sim *sim, double dt);                    /* against faces */

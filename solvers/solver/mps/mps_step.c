@@ -311,6 +311,11 @@ int mps_correction_phase(mps_data *d, mf_sim *sim, double dt)
     }
     mf_pairs v;
     MF_CALL(mps_pairs(d, sim, d->h_grad, &v));
+    if (d->s.wall_pressure_extrapolated && !d->wall) { /* the walls' p by the Neumann condition */
+        MF_CALL(mps_scheme_reserve(d, p->n));
+        mps_wall_pressure_extrapolate(d, sim, &v, pr, d->work);
+        pr = d->work;
+    }
     mf_gradient(&v, &d->k_grad, pr, d->s.gradient_pmin, d->is_fluid, d->not_dummy, d->grad);
     MF_CALL(mps_bodies_pressure(d, sim, pr)); /* the rigid bodies' share, at r* */
     const double rho = sim->fluid[0].rho;
