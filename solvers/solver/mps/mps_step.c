@@ -313,7 +313,11 @@ int mps_correction_phase(mps_data *d, mf_sim *sim, double dt)
     MF_CALL(mps_pairs(d, sim, d->h_grad, &v));
     if (d->s.wall_pressure_extrapolated && !d->wall) { /* the walls' p by the Neumann condition */
         MF_CALL(mps_scheme_reserve(d, p->n));
+        /* copies (other ranks', periodic images) carry no force of their own
+         * at r*: their owners' f, then their owners' p_w */
+        MF_CALL(mps_halo_sync(d, sim, d->acc, 3 * sizeof *d->acc));
         mps_wall_pressure_extrapolate(d, sim, &v, pr, d->work);
+        MF_CALL(mps_halo_sync(d, sim, d->work, sizeof *d->work));
         pr = d->work;
     }
     mf_gradient(&v, &d->k_grad, pr, d->s.gradient_pmin, d->is_fluid, d->not_dummy, d->grad);
