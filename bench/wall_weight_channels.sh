@@ -6,6 +6,7 @@
 # solution at t = 1 s), with the observed order between spacings.
 #   bench/wall_weight_channels.sh            # both cases, three spacings
 #   CASES=couette2D L0S='0.01 0.005' bench/wall_weight_channels.sh
+#   WALLS=wallWeight MAXDI=0.025 bench/wall_weight_channels.sh   # a quarter of the step
 # Two runs at a time, one thread each; writes bench/results/wall_weight_channels.csv.
 cd "$(dirname "$0")/.." || exit 1
 MPSFLOW=${MPSFLOW:-$PWD/build/driver/mpsflow}
@@ -13,6 +14,7 @@ MPSFLOW=${MPSFLOW:-$PWD/build/driver/mpsflow}
 export OMP_NUM_THREADS=1
 cases=${CASES:-poiseuille2D couette2D}
 l0s=${L0S:-0.01 0.005 0.0025}
+walls=${WALLS:-particles wallWeight}
 out=bench/results; mkdir -p "$out"
 csv=$out/wall_weight_channels.csv
 work=$(mktemp -d)
@@ -22,6 +24,8 @@ one() { # CASE WALL L0
     d=$work/$1_$2_$3
     cp -r "tutorials/$1" "$d"
     sed -i "/^MPSCoeffs/,/^}/ s/^}\$/    wall $2;\n}/" "$d/system/solverDict"
+    # the explicit viscous limit nu dt / l0^2 (the tutorials' 0.1; it sets dt ~ l0^2)
+    [ -z "$MAXDI" ] || sed -i "s/^maxDi .*/maxDi $MAXDI;/" "$d/system/controlDict"
     t0=$(date +%s.%N)
     "$MPSFLOW" -case "$d" -l0 "$3" > "$d/log" 2>&1 || echo "$1 $2 $3: stopped" > "$d/err"
     t1=$(date +%s.%N)
@@ -30,11 +34,11 @@ one() { # CASE WALL L0
     echo "$1,$2,$3,$np,$e,$(awk "BEGIN { printf \"%.1f\", $t1 - $t0 }")" > "$d/row"
 }
 
-echo "wall particles vs wallWeight, channels; $(getconf _NPROCESSORS_ONLN) cores, load $(cut -d' ' -f1-3 /proc/loadavg), $(date -u '+%Y-%m-%d %H:%M UTC')"
+echo "walls ($walls), channels, maxDi ${MAXDI:-0.1}; $(getconf _NPROCESSORS_ONLN) cores, load $(cut -d' ' -f1-3 /proc/loadavg), $(date -u '+%Y-%m-%d %H:%M UTC')"
 n=0
 for c in $cases; do
     for l0 in $l0s; do
-        for w in particles wallWeight; do
+        for w in $walls; do
             one "$c" "$w" "$l0" &
             n=$((n + 1))
             [ $((n % 2)) = 0 ] && wait
@@ -43,7 +47,7 @@ for c in $cases; do
 done
 wait
 echo "case,wall,l0,particles,error,seconds" > "$csv"
-for c in $cases; do for w in particles wallWeight; do for l0 in $l0s; do
+for c in $cases; do for w in $walls; do for l0 in $l0s; do
     cat "$work/${c}_${w}_${l0}/row"; done; done; done >> "$csv"
 # the observed order between successive spacings: log(e1/e2)/log(l1/l2)
 awk -F, 'NR > 1 { key = $1 " " $2
