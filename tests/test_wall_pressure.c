@@ -1,6 +1,6 @@
 /* test_wall_pressure.c: what MPSCoeffs `wallPressureExtrapolated` does on
  * the resting tank (issue 13; docs/notes/mps.md, 2026-12-03 resting2 and
- * resting3; solvers/solver/mps/mps_continued_pressure.c).
+ * resting3; solvers/solver/mps/mps_wall_pressure.c).
  *
  * bench/cases/restingTank as it is (2-D, W/H 2, H 0.2 m, l0 0.01, the MPS
  * default `robust`) for 0.05 s, 50 steps:
