@@ -94,7 +94,7 @@ while [ -n "$1" ]; do
     shift; [ -n "$1" ] && shift
 done
 labels=""
-for d in "$work"/a_*; do
+for d in $(ls -d "$work"/a_* | sort -t_ -k2 -g); do
     cat "$d/row"
     labels="$labels ${d##*/}=$d"
 done
