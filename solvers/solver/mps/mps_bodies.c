@@ -163,8 +163,14 @@ static int pressure_pairs(mps_data *d, mf_sim *sim, const double *pressure)
         scratch_free(&s);
         return MF_ERROR(MF_ERR_MEMORY, "out of memory summing the forces on the rigid bodies");
     }
-    /* p^ as the step's gradient has it (mps_gradient_pairs) */
-    mf_neighbour_min(&v, pressure, true, d->own_reference, d->not_dummy, d->not_dummy, fhat);
+    /* p^ as the step's gradient has it (mps_gradient_pairs), the halo
+     * copies' included: the pair term reads p^ of both particles */
+    const int rc = mps_corrected_pmin(d, sim, &v, pressure, fhat);
+    if (rc != 0) {
+        free(fhat);
+        scratch_free(&s);
+        return mf_error_trace(rc, __FILE__, __LINE__, __func__);
+    }
     const mf_gradient_opts o = {.f = pressure, .coef = 1.0 / sim->fluid[0].rho, .fhat = fhat};
     for (size_t k = 0; k < ws->n; k++) {
         if (!ws->w[k].body)
