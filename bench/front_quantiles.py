@@ -9,6 +9,10 @@ At the snapshots nearest T = t sqrt(2g/A) = 1, 2, 3, 4, 5 it prints, in units of
   rule     surgeFront's front: the largest x of a particle with at least two others within 2.1 l0
   drop     how many leading particles that rule passed over (isolated spray)
   head     the particles within 4 l0 of the rule's front particle: how thick the tip is
+  h2% h5%  the end of the layer at least 0.02 a (0.05 a) deep, from the back wall on: the fluid's
+           depth in bins 2 l0 wide (particles times l0^2 over the bin's width), the first bin
+           below the depth ends the layer; a front set by a physical depth, not by l0, that
+           ignores the sheet thinner than it (and spray ahead of a gap)
 and the fluid's kinetic energy is in the run's postProcessing/energy. Reads the HDF5 snapshots
 with h5dump (hdf5-tools), no numpy.
 """
@@ -49,6 +53,21 @@ def rule_front(points, l0):
     return len(order), 0.0, 0
 
 
+def layer_front(points, l0, depth):
+    """The largest x in the last bin of the layer at least DEPTH deep, walking from the back
+    wall (x = 0); 0 if the first bin is shallower."""
+    width = 2 * l0
+    count, far = {}, {}
+    for x, _ in points:
+        k = int(x // width)
+        count[k] = count.get(k, 0) + 1
+        far[k] = max(far.get(k, x), x)
+    k = 0
+    while count.get(k, 0) * l0 * l0 / width >= depth:
+        k += 1
+    return far[k - 1] if k > 0 else 0.0
+
+
 def main():
     a = float(sys.argv[1])
     tscale = (2 * 9.81 / a) ** 0.5
@@ -66,8 +85,10 @@ def main():
             xs = sorted((x for x, _ in pts), reverse=True)
             q = [xs[int(f * len(xs))] / a for f in (0.005, 0.02, 0.05)]
             drop, x_rule, head = rule_front(pts, l0)
+            h = [layer_front(pts, l0, f * a) / a for f in (0.02, 0.05)]
             print("  T %.2f  max %.3f  rule %.3f  drop %d  head %d  q0.5%% %.3f  q2%% %.3f  q5%% %.3f"
-                  % (T, xs[0] / a, x_rule / a, drop, head, q[0], q[1], q[2]))
+                  "  h2%% %.3f  h5%% %.3f"
+                  % (T, xs[0] / a, x_rule / a, drop, head, q[0], q[1], q[2], h[0], h[1]))
 
 
 if __name__ == "__main__":

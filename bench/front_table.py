@@ -5,7 +5,8 @@ For bench/dambreak_front_refinement.sh. Each RUN holds validation/result.csv (th
 Z at the reference T) and ztable.csv (Z at dense T, the same metric with a probe reference). Prints a
 markdown table of Z at the reference T beside the reference, each run's RMS (the metric's number),
 and the time shift dT that best fits the run to the reference (the run read at T - dT) with the RMS
-that leaves: a delayed start (a gate removed in finite time) shifts a front in T; a slower front
+that leaves, and the RMS difference of Z between successive runs (self-convergence: it falls
+with refinement if the runs converge to some answer, whatever the experiment says): a delayed start (a gate removed in finite time) shifts a front in T; a slower front
 (friction, a smaller scale) changes its slope, which no shift removes.
 """
 import math
@@ -54,6 +55,9 @@ def main():
         base, n = math.sqrt(sum(e) / len(e)), len(e)
         best = min((rms_shifted(ref, dense, 0.005 * k)[0], 0.005 * k) for k in range(200))
         print("%s: RMS %.3f over %d points; best shift dT = %.3f leaves RMS %.3f" % (label, base, n, best[1], best[0]))
+    for (l1, z1, _), (l2, z2, _) in zip(runs, runs[1:]):
+        d = [(a - b) ** 2 for a, b in zip(z1, z2) if not (math.isnan(a) or math.isnan(b))]
+        print("%s to %s: RMS difference of Z %.3f over %d points" % (l1, l2, math.sqrt(sum(d) / len(d)), len(d)))
 
 
 if __name__ == "__main__":
