@@ -2,8 +2,9 @@
 # damBreak2D's surge front against refinement: the tutorial's surgeFront
 # metric (Martin & Moyce 1952, a = 1.125 in) at several spacings, the front
 # Z(T) of each run beside the experiment, and the time shift that fits each
-# run best. Not a test: the tables of docs/topics/schemes.md, "The dam-break
-# front with refinement (2026-12-03)".
+# run best, the RMS difference between successive spacings and the RMS against
+# Martin & Moyce's larger column (a = 2.25 in). Not a test: the tables of
+# docs/notes/front.md (2026-12-03).
 #   bench/dambreak_front_refinement.sh [N ...]      spacings l0 = a/N (default 12.5 25 50)
 # Environment:
 #   SCALE=tutorial    the tutorial as it is, a = 0.25 m (default)
@@ -98,4 +99,4 @@ for d in $(ls -d "$work"/a_* | sort -t_ -k2 -g); do
     cat "$d/row"
     labels="$labels ${d##*/}=$d"
 done
-python3 bench/front_table.py "$src/validation/martin_moyce_1952.csv" $labels
+python3 bench/front_table.py --also bench/martin_moyce_1952_a2.25in.csv "$src/validation/martin_moyce_1952.csv" $labels

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """front_quantiles.py A RUN ...: how a dam-break run's leading fluid is spread, snapshot by snapshot.
 
-For docs/topics/schemes.md ("The dam-break front with refinement"). A is the column width in m.
+For docs/notes/front.md. A is the column width in m.
 At the snapshots nearest T = t sqrt(2g/A) = 1, 2, 3, 4, 5 it prints, in units of A:
   max      the largest x of a fluid particle (surgeFront's front, before its neighbour test)
   q0.5 ... the x beyond which 0.5%, 2%, 5% of the fluid particles lie: a front defined by a

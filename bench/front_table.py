@@ -1,12 +1,14 @@
 #!/usr/bin/env python3
-"""front_table.py REFERENCE.csv LABEL=RUN ...: the surge fronts of several damBreak2D runs side by side.
+"""front_table.py [--also REFERENCE2.csv] REFERENCE.csv LABEL=RUN ...: the surge fronts of several damBreak2D runs side by side.
 
 For bench/dambreak_front_refinement.sh. Each RUN holds validation/result.csv (the surgeFront metric's
 Z at the reference T) and ztable.csv (Z at dense T, the same metric with a probe reference). Prints a
 markdown table of Z at the reference T beside the reference, each run's RMS (the metric's number),
 and the time shift dT that best fits the run to the reference (the run read at T - dT) with the RMS
 that leaves, and the RMS difference of Z between successive runs (self-convergence: it falls
-with refinement if the runs converge to some answer, whatever the experiment says): a delayed start (a gate removed in finite time) shifts a front in T; a slower front
+with refinement if the runs converge to some answer, whatever the experiment says); with --also,
+each run's RMS against a second reference too (Z at its T from ztable.csv; the points the run
+covers): a delayed start (a gate removed in finite time) shifts a front in T; a slower front
 (friction, a smaller scale) changes its slope, which no shift removes.
 """
 import math
@@ -38,9 +40,14 @@ def rms_shifted(ref, dense, shift):
 
 
 def main():
-    ref = [(r[0], r[1]) for r in rows(sys.argv[1])]
+    args = sys.argv[1:]
+    also = None
+    if args[:1] == ["--also"]:
+        also = [(r[0], r[1]) for r in rows(args[1])]
+        args = args[2:]
+    ref = [(r[0], r[1]) for r in rows(args[0])]
     runs = []
-    for arg in sys.argv[2:]:
+    for arg in args[1:]:
         label, path = arg.split("=", 1)
         result = rows(path + "/validation/result.csv")
         dense = [(r[0], r[1]) for r in rows(path + "/ztable.csv")]
@@ -58,6 +65,9 @@ def main():
     for (l1, z1, _), (l2, z2, _) in zip(runs, runs[1:]):
         d = [(a - b) ** 2 for a, b in zip(z1, z2) if not (math.isnan(a) or math.isnan(b))]
         print("%s to %s: RMS difference of Z %.3f over %d points" % (l1, l2, math.sqrt(sum(d) / len(d)), len(d)))
+    for label, _, dense in runs if also else []:
+        e, n = rms_shifted(also, dense, 0.0)
+        print("%s: RMS %.3f against the second reference over %d points" % (label, e, n))
 
 
 if __name__ == "__main__":
