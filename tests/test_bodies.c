@@ -53,6 +53,7 @@
 
 #include <hdf5.h>
 
+#include "body_cases.h"
 #include "case_util.h"
 #include "mf_test.h"
 
@@ -63,28 +64,6 @@ static const char *const control =
     "endTime 0.2;\ndeltaT 1e-4;\nadjustTimeStep yes;\nmaxCo 0.2;\nmaxDeltaT 1e-3;\n"
     "writeControl adjustableRunTime;\nwriteInterval 0.02;\n";
 static const char *const fluids = "water { rho 1000; nu 1e-4; }\n";
-static const char *const solver =
-    "solver MPS;\n"
-    "MPSCoeffs { gradient corrected; laplacian paper; collision no; shifting none; }\n"
-    "pressure { solver PCG_BoomerAMG; tolerance 1e-10; }\n";
-
-/* A blob 0.2 m square around a box body 0.06 m square, in a closed tank
- * 0.4 m square. */
-static void geometry(char *out, size_t len, double u)
-{
-    snprintf(out, len,
-             "dimension 2;\nparticleSpacing %g;\n"
-             "fluidBlocks {\n"
-             " a { type box; min (0.1 0.1 0); max (0.17 0.3 0); fluid water; }\n"
-             " b { type box; min (0.23 0.1 0); max (0.3 0.3 0); fluid water; }\n"
-             " c { type box; min (0.17 0.1 0); max (0.23 0.17 0); fluid water; }\n"
-             " d { type box; min (0.17 0.23 0); max (0.23 0.3 0); fluid water; }\n}\n"
-             "walls { tank { type box; min (0 0 0); max (0.4 0.4 0); } }\n"
-             "obstacles { body { type box; min (0.17 0.17 0); max (0.23 0.23 0);\n"
-             " motion { type rigid; density 1000; g (0 0 0); velocity (%g 0 0); } } }\n",
-             L0, u);
-}
-
 /* Rows of bodyState.csv: time, velocity (vx vy), force (Fx Fy). */
 typedef struct track {
     size_t n;
@@ -183,9 +162,10 @@ static void check_momentum(const char *exe)
 {
     const double U = 0.05;
     char geo[2048];
-    geometry(geo, sizeof geo, U);
+    tc_momentum_geometry(geo, sizeof geo, L0, U);
     tc_case c;
-    CHECK_OK(tc_case_from_strings(&c, exe, "bodies-momentum", control, solver, fluids, geo));
+    CHECK_OK(tc_case_from_strings(&c, exe, "bodies-momentum", control, TC_MOMENTUM_SOLVER, fluids,
+                                  geo));
     track tr;
     bool ok = run(&c, "momentum");
     if (ok) {
@@ -261,9 +241,10 @@ static void check_momentum(const char *exe)
 static void check_rest(const char *exe)
 {
     char geo[2048];
-    geometry(geo, sizeof geo, 0.0);
+    tc_momentum_geometry(geo, sizeof geo, L0, 0.0);
     tc_case c;
-    CHECK_OK(tc_case_from_strings(&c, exe, "bodies-rest", control, solver, fluids, geo));
+    CHECK_OK(tc_case_from_strings(&c, exe, "bodies-rest", control, TC_MOMENTUM_SOLVER, fluids,
+                                  geo));
     track tr;
     bool ok = run(&c, "at rest");
     if (ok) {
@@ -349,13 +330,15 @@ static void check_restart(const char *exe)
 {
     const double U = 0.05;
     char geo[2048];
-    geometry(geo, sizeof geo, U);
+    tc_momentum_geometry(geo, sizeof geo, L0, U);
     static const char *const ctl =
         "endTime 0.1;\ndeltaT 1e-4;\nadjustTimeStep yes;\nmaxCo 0.2;\nmaxDeltaT 1e-3;\n"
         "writeControl adjustableRunTime;\nwriteInterval 0.02;\n";
     tc_case whole, split;
-    CHECK_OK(tc_case_from_strings(&whole, exe, "bodies-whole", ctl, solver, fluids, geo));
-    CHECK_OK(tc_case_from_strings(&split, exe, "bodies-split", ctl, solver, fluids, geo));
+    CHECK_OK(tc_case_from_strings(&whole, exe, "bodies-whole", ctl, TC_MOMENTUM_SOLVER, fluids,
+                                  geo));
+    CHECK_OK(tc_case_from_strings(&split, exe, "bodies-split", ctl, TC_MOMENTUM_SOLVER, fluids,
+                                  geo));
     bool ok = run(&whole, "restart: the straight run");
     int s1 = tc_case_run(&split, NULL, (const char *const[]){"-endTime", "0.04", NULL});
     int s2 = s1 == 0 ? tc_case_run(&split, NULL, (const char *const[]){"-latestTime", NULL}) : -1;

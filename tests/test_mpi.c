@@ -14,6 +14,11 @@
  * part "restart": the dam break written on 2 ranks at step 25 and restarted
  *   on 1 and on 3 ends where the straight run on 2 ends, within the same
  *   bounds.
+ * part "bodies": rigid bodies moved by the fluid (floatingBox on 1, 2 and 3
+ *   ranks and restarted from 2 onto 1 and 3; the corrected gradient's pair
+ *   reaction, contact between bodies and with the floor, a disk entering
+ *   water, a 3-D box and sphere, each on 2 and 3 ranks): the particles and
+ *   every body's trajectory as the serial run's, within the same bounds.
  * part "balance": a start that leaves all the fluid on one rank (system/
  *   decomposeParDict firstPartition none: each rank keeps its share of the
  *   scene in the order it was built, the fluid block first) is rebalanced at
@@ -27,6 +32,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "body_cases.h"
 #include "case_util.h"
 #include "mf_test.h"
 
@@ -96,18 +102,26 @@ static const case_spec more_cases[] = {
     {"boxFilling", 0.08, 2e-3, "", true, NULL},
 };
 
-static int make_case(tc_case *c, const case_spec *cs, const char *tag, long steps,
-                     long write_every)
+/* controlDict: steps fixed steps of dt, a snapshot every write_every. */
+static int write_control(const tc_case *c, double dt, long steps, long write_every,
+                         const char *extra)
 {
-    char src[1024], control[1024];
-    snprintf(src, sizeof src, "%s/%s", tutorials, cs->name);
-    if (tc_case_from_dir(c, exe, tag, src) != 0)
-        return -1;
+    char control[1024];
     snprintf(control, sizeof control,
              "endTime %.17g;\nadjustTimeStep no;\ndeltaT %.17g;\nwriteControl timeStep;\n"
              "writeInterval %ld;\n%s",
-             steps * cs->dt, cs->dt, write_every, cs->extra_control);
-    if (tc_case_write(c, TC_CONTROL, control) != 0)
+             steps * dt, dt, write_every, extra ? extra : "");
+    return tc_case_write(c, TC_CONTROL, control);
+}
+
+static int make_case(tc_case *c, const case_spec *cs, const char *tag, long steps,
+                     long write_every)
+{
+    char src[1024];
+    snprintf(src, sizeof src, "%s/%s", tutorials, cs->name);
+    if (tc_case_from_dir(c, exe, tag, src) != 0)
+        return -1;
+    if (write_control(c, cs->dt, steps, write_every, cs->extra_control) != 0)
         return -1;
     if (!cs->forces)
         return 0;
@@ -410,19 +424,9 @@ static void part_restart(void)
         mf_sim got;
         memset(&got, 0, sizeof got);
         /* 25 steps on 2 ranks (a snapshot at step 25), then to step 50. */
-        if (make_case(&half, cs, tag, 50, 25) == 0) {
-            char control[512];
-            snprintf(control, sizeof control,
-                     "endTime %.17g;\nadjustTimeStep no;\ndeltaT %.17g;\nwriteControl timeStep;\n"
-                     "writeInterval 25;\n",
-                     25 * cs->dt, cs->dt);
-            tc_case_write(&half, TC_CONTROL, control);
+        if (make_case(&half, cs, tag, 25, 25) == 0) {
             int ok = run(&half, 2, cs, NULL) == 0;
-            snprintf(control, sizeof control,
-                     "endTime %.17g;\nadjustTimeStep no;\ndeltaT %.17g;\nwriteControl timeStep;\n"
-                     "writeInterval 25;\n",
-                     50 * cs->dt, cs->dt);
-            tc_case_write(&half, TC_CONTROL, control);
+            write_control(&half, cs->dt, 50, 25, NULL);
             ok = ok && run(&half, np == 1 ? 0 : np, cs, "-latestTime") == 0 &&
                  load_last(&half, &got) == 0;
             CHECK_MSG(ok, "%s: the runs", what);
@@ -440,6 +444,337 @@ static void part_restart(void)
         tc_case_destroy(&half);
     }
     tc_sim_free(&ref);
+}
+
+/* Rigid bodies (issue 18) on 1, 2 and 3 ranks: floatingBox at twice its
+ * spacing, 50 steps of 1 ms from the box's release on the water. */
+static const case_spec body_case = {"floatingBox", 0.02, 1e-3, "", false, NULL};
+
+#define BODY_COLS 20 /* time, centre, quaternion, velocity, omega, force, torque */
+
+typedef struct body_rows {
+    int n;
+    double (*r)[BODY_COLS];
+} body_rows;
+
+/* The rows of postProcessing/<body>/bodyState.csv (-1: no file). */
+static int read_body_rows(const tc_case *c, const char *body, body_rows *out)
+{
+    char path[700], line[1024];
+    snprintf(path, sizeof path, "%s/postProcessing/%s/bodyState.csv", c->dir, body);
+    out->n = 0;
+    out->r = NULL;
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return -1;
+    int cap = 0;
+    while (fgets(line, sizeof line, f)) {
+        if (out->n == cap) {
+            cap = cap ? 2 * cap : 64;
+            void *grown = realloc(out->r, (size_t)cap * sizeof *out->r);
+            if (!grown)
+                break;
+            out->r = grown;
+        }
+        char *at = line, *end;
+        int k = 0;
+        for (; k < BODY_COLS; k++, at = end + (*end == ',')) {
+            out->r[out->n][k] = strtod(at, &end);
+            if (end == at)
+                break;
+        }
+        out->n += k == BODY_COLS; /* the comment and the column names are not rows */
+    }
+    fclose(f);
+    return out->n;
+}
+
+/* Body `body`'s trajectory of run b against run a: the same times, and the
+ * centre and velocity within the particles' bounds (POS_BOUND of l0,
+ * VEL_BOUND of the largest speed) at every step. */
+static void compare_body(const char *what, const tc_case *a, const tc_case *b, const char *body,
+                         double l0, int expect_rows)
+{
+    body_rows ra, rb;
+    const int na = read_body_rows(a, body, &ra), nb = read_body_rows(b, body, &rb);
+    CHECK_MSG(na == expect_rows && nb == expect_rows,
+              "%s: %s's bodyState.csv has %d and %d rows, %d expected", what, body, na, nb,
+              expect_rows);
+    double dx = 0, dv = 0, vmax = 1e-3, dt = 0;
+    for (int r = 0; r < na && r < nb; r++) {
+        dt = fmax(dt, fabs(ra.r[r][0] - rb.r[r][0]));
+        for (int c = 0; c < 3; c++) {
+            dx = fmax(dx, fabs(ra.r[r][1 + c] - rb.r[r][1 + c]));
+            dv = fmax(dv, fabs(ra.r[r][8 + c] - rb.r[r][8 + c]));
+            vmax = fmax(vmax, fabs(ra.r[r][8 + c]));
+        }
+    }
+    const double *end = nb > 0 ? rb.r[nb - 1] : NULL;
+    printf("%s: body '%s' over %d rows: max |dx| = %.3g l0, max |dv| = %.3g of %.3g m/s "
+           "(centre at the end %.9g %.9g %.9g, velocity %.9g %.9g %.9g)\n",
+           what, body, nb, dx / l0, dv / vmax, vmax, end ? end[1] : 0, end ? end[2] : 0,
+           end ? end[3] : 0, end ? end[8] : 0, end ? end[9] : 0, end ? end[10] : 0);
+    CHECK_MSG(dt <= 1e-9, "%s: the rows' times differ by %g s", what, dt);
+    CHECK_MSG(dx <= POS_BOUND * l0, "%s: body %s's centre differs by %g l0", what, body, dx / l0);
+    CHECK_MSG(dv <= VEL_BOUND * vmax, "%s: body %s's velocity differs by %g of the largest",
+              what, body, dv / vmax);
+    free(ra.r);
+    free(rb.r);
+}
+
+/* The rows of the body's file at the end: the initial state and one a step. */
+#define BODY_STEPS 50
+
+static void part_floating_box(void)
+{
+    const case_spec *cs = &body_case;
+    tc_case ref_case;
+    mf_sim ref;
+    memset(&ref, 0, sizeof ref);
+    if (make_case(&ref_case, cs, "bodies-serial", BODY_STEPS, BODY_STEPS) != 0 ||
+        run(&ref_case, 0, cs, NULL) != 0 || load_last(&ref_case, &ref) != 0) {
+        CHECK_MSG(0, "floatingBox: the serial run");
+        tc_case_destroy(&ref_case);
+        return;
+    }
+    const double l0 = ref.l0;
+    /* The box moved: a comparison of bodies at rest would prove nothing. */
+    body_rows rows;
+    const int nr = read_body_rows(&ref_case, "box", &rows);
+    CHECK_MSG(nr == BODY_STEPS + 1 && fabs(rows.r[nr - 1][9]) > 0.1,
+              "floatingBox serial: %d rows, the box's speed %g m/s at the end", nr,
+              nr > 0 ? rows.r[nr - 1][9] : 0);
+    free(rows.r);
+    for (int np = 1; np <= 3; np++) {
+        char tag[64], what[96];
+        snprintf(tag, sizeof tag, "bodies-np%d", np);
+        snprintf(what, sizeof what, "floatingBox on %d rank%s", np, np > 1 ? "s" : "");
+        tc_case c;
+        mf_sim got;
+        memset(&got, 0, sizeof got);
+        if (make_case(&c, cs, tag, BODY_STEPS, BODY_STEPS) == 0 && run(&c, np, cs, NULL) == 0 &&
+            load_last(&c, &got) == 0) {
+            compare(what, &ref, &got, l0, INT64_MAX);
+            compare_body(what, &ref_case, &c, "box", l0, BODY_STEPS + 1);
+        } else {
+            CHECK_MSG(0, "%s: the run", what);
+        }
+        tc_sim_free(&got);
+        tc_case_destroy(&c);
+    }
+    /* Written on 2 ranks at step 25, restarted on 1 (serially) and on 3 to
+     * step 50: the serial run's particles and trajectory, and the file's rows
+     * once each. */
+    for (int np = 0; np <= 3; np += 3) {
+        char tag[64], what[96];
+        snprintf(tag, sizeof tag, "bodies-restart-np%d", np);
+        snprintf(what, sizeof what, "floatingBox written on 2 ranks, restarted on %d",
+                 np ? np : 1);
+        tc_case half;
+        mf_sim got;
+        memset(&got, 0, sizeof got);
+        if (make_case(&half, cs, tag, BODY_STEPS / 2, BODY_STEPS / 2) == 0) {
+            int ok = run(&half, 2, cs, NULL) == 0;
+            write_control(&half, cs->dt, BODY_STEPS, BODY_STEPS / 2, NULL);
+            ok = ok && run(&half, np, cs, "-latestTime") == 0 && load_last(&half, &got) == 0;
+            CHECK_MSG(ok, "%s: the runs", what);
+            if (ok) {
+                CHECK(got.step == BODY_STEPS);
+                compare(what, &ref, &got, l0, INT64_MAX);
+                compare_body(what, &ref_case, &half, "box", l0, BODY_STEPS + 1);
+            }
+        }
+        tc_sim_free(&got);
+        tc_case_destroy(&half);
+    }
+    tc_sim_free(&ref);
+    tc_case_destroy(&ref_case);
+}
+
+/* The other paths of the bodies' coupling on N ranks, each case on 2 and
+ * 3 ranks against its serial run (particles by id, every body's every
+ * row):
+ *   momentum   test_bodies' closed box without gravity, the body set moving
+ *              in a free blob: the corrected gradient's pair reaction (CMPS)
+ *              and the eq. 7 Laplacian's, whose pair terms read the halo
+ *              copies' p^ and WallId;
+ *   contact    two boxes dropped on the floor of a dry tank, the upper
+ *              landing on the lower (0.14 and 0.2 s): body-wall and body-body
+ *              contact. Gravity acts on the bodies only (motion g): a puddle
+ *              under gravity in a corner, as test_bodies has, amplifies
+ *              rounding over the 250 steps (a serial run that only reorders
+ *              its particles: 3.8e-6 l0) where the bodies agree to the last
+ *              digit; this one stays at rest. Decomposed by load alone
+ *              (multiCriteria no), so that the cuts run through both bodies
+ *              (measured: 2 ranks hold 21 and 65 of the lower box's 86 outer
+ *              particles and 11 and 35 of the upper's 46; 3 ranks 47 and 39,
+ *              37 and 9);
+ *   waterEntry the tutorial's disk at l0 0.011 m entering the water at
+ *              2.955 m/s, 0.03 s: the surface pressure of a round body.
+ *              Pressure tolerance 1e-12: at the tutorial's 1e-8 the impact
+ *              amplifies the solve's tolerance (hypre's PCG on N ranks,
+ *              mpsflow's V-cycle serially) to 2.6e-6 l0 in 0.03 s, beyond
+ *              POS_BOUND, as it amplifies a serial run's rounding (the
+ *              particles only reordered: 2.1e-6 l0); at 1e-12, 2e-10 l0;
+ *   floating3D a box and a sphere (3-D, l0 0.02 m) released half in the
+ *              water: the faces of a 3-D box, a sphere's surface.
+ * The serial run first shows the physics each comparison is of: the body
+ * ends within l0/4 of rest_y where given, and at a speed below max_speed
+ * (what the fluid or the contact took off a free body's). */
+typedef struct body_check {
+    const char *name;
+    double rest_y;    /* NAN: not checked */
+    double max_speed; /* m/s, at the end */
+} body_check;
+
+typedef struct body_spec {
+    case_spec cs;     /* name: the tutorial copied, or NULL: from the strings */
+    const char *tag;
+    long steps;
+    const char *solver, *fluids, *geometry, *decompose; /* NULL: the tutorial's, none */
+    void (*make_geometry)(char *out, size_t len); /* when geometry is NULL */
+    body_check bodies[2];
+} body_spec;
+
+/* test_bodies' momentum case, moving at 0.05 m/s (tests/body_cases.h). */
+static void momentum_geometry(char *out, size_t len)
+{
+    tc_momentum_geometry(out, len, 0.01, 0.05);
+}
+
+static const char *const water_fluids = "water { rho 1000; nu 1e-4; }\n";
+
+static const body_spec body_specs[] = {
+    {{NULL, 0, 1e-3, "", false, NULL}, "momentum", 100, TC_MOMENTUM_SOLVER, NULL, NULL, NULL,
+     momentum_geometry, {{"body", NAN, 0.045}, {NULL, 0, 0}}},
+    {{NULL, 0, 1e-3, "", false, NULL}, "contact", 250,
+     "solver MPS;\npressure { solver PCG_BoomerAMG; tolerance 1e-8; }\n",
+     NULL,
+     "dimension 2;\nparticleSpacing 0.01;\n"
+     "fluidBlocks { water { type box; min (0 0 0); max (0.1 0.05 0); fluid water; } }\n"
+     "walls { tank { type box; min (0 0 0); max (0.6 0.5 0); open (ymax); } }\n"
+     "obstacles {\n"
+     " lower { type box; min (0.15 0.1 0); max (0.55 0.15 0);\n"
+     "  motion { type rigid; density 500; g (0 -9.81 0); } }\n"
+     " upper { type box; min (0.2 0.25 0); max (0.4 0.3 0);\n"
+     "  motion { type rigid; density 500; g (0 -9.81 0); } } }\n",
+     "multiCriteria no;\n", NULL,
+     {{"lower", 0.025, 0.05}, {"upper", 0.075, 0.05}}},
+    {{"waterEntry", 0.011, 2.5e-4, "", false, NULL}, "waterEntry", 120,
+     "solver MPS;\npressure { solver PCG_BoomerAMG; tolerance 1e-12; }\n"
+     "forces { gravity { g (0 -9.81 0); } }\n",
+     NULL, NULL, NULL, NULL,
+     {{"cylinder", NAN, 1.5}, {NULL, 0, 0}}},
+    {{NULL, 0, 1e-3, "", false, NULL}, "floating3D", 50,
+     "solver MPS;\npressure { solver PCG_BoomerAMG; tolerance 1e-8; }\n"
+     "forces { gravity { g (0 -9.81 0); } }\n",
+     "water { rho 1000; nu 1e-6; }\n",
+     "dimension 3;\nparticleSpacing 0.02;\n"
+     "fluidBlocks { water { type box; min (0 0 0); max (0.3 0.1 0.2); fluid water; } }\n"
+     "walls { tank { type box; min (0 0 0); max (0.3 0.3 0.2); open (ymax); } }\n"
+     "obstacles {\n"
+     " box { type box; min (0.04 0.1 0.04); max (0.14 0.16 0.16);\n"
+     "  motion { type rigid; density 500; g (0 -9.81 0); } }\n"
+     " ball { type sphere; centre (0.22 0.14 0.1); radius 0.04;\n"
+     "  motion { type rigid; density 500; g (0 -9.81 0); } } }\n",
+     NULL, NULL,
+     {{"box", NAN, 0.4}, {"ball", NAN, 0.4}}},
+};
+
+static int make_body_case(tc_case *c, const body_spec *bs, const char *tag)
+{
+    int rc;
+    if (bs->cs.name) {
+        rc = make_case(c, &bs->cs, tag, bs->steps, bs->steps);
+    } else {
+        char geometry[2048];
+        if (!bs->geometry)
+            bs->make_geometry(geometry, sizeof geometry);
+        rc = tc_case_from_strings(c, exe, tag, NULL, NULL, water_fluids,
+                                  bs->geometry ? bs->geometry : geometry);
+        rc = rc != 0 ? rc : write_control(c, bs->cs.dt, bs->steps, bs->steps, NULL);
+    }
+    if (rc == 0 && bs->solver)
+        rc = tc_case_write(c, TC_SOLVER, bs->solver);
+    if (rc == 0 && bs->fluids)
+        rc = tc_case_write(c, TC_FLUIDS, bs->fluids);
+    if (rc == 0 && bs->decompose)
+        rc = tc_case_write(c, "system/decomposeParDict", bs->decompose);
+    return rc;
+}
+
+/* The serial run's physics (body_check). */
+static void check_serial_bodies(const body_spec *bs, const tc_case *c, double l0)
+{
+    for (int k = 0; k < 2 && bs->bodies[k].name; k++) {
+        const body_check *b = &bs->bodies[k];
+        body_rows rows;
+        const int n = read_body_rows(c, b->name, &rows);
+        CHECK_MSG(n == bs->steps + 1, "%s serial: body %s: %d rows", bs->tag, b->name, n);
+        if (n > 0) {
+            const double *e = rows.r[n - 1];
+            const double speed = sqrt(e[8] * e[8] + e[9] * e[9] + e[10] * e[10]);
+            printf("%s serial: body '%s' at t = %g: y = %.5f m, speed %.4g m/s\n", bs->tag,
+                   b->name, e[0], e[2], speed);
+            CHECK_MSG(speed < b->max_speed, "%s serial: body %s at %g m/s, %g expected below",
+                      bs->tag, b->name, speed, b->max_speed);
+            if (!isnan(b->rest_y))
+                CHECK_MSG(fabs(e[2] - b->rest_y) < 0.25 * l0,
+                          "%s serial: body %s at y = %g, resting at %g expected", bs->tag,
+                          b->name, e[2], b->rest_y);
+        }
+        free(rows.r);
+    }
+}
+
+static void part_body_paths(void)
+{
+    for (size_t k = 0; k < sizeof body_specs / sizeof body_specs[0]; k++) {
+        const body_spec *bs = &body_specs[k];
+        const char *only = getenv("MF_TEST_CASE");
+        if (only && strcmp(only, bs->tag) != 0)
+            continue;
+        tc_case ref_case;
+        mf_sim ref;
+        memset(&ref, 0, sizeof ref);
+        char tag[64];
+        snprintf(tag, sizeof tag, "bodies-%s", bs->tag);
+        if (make_body_case(&ref_case, bs, tag) != 0 || run(&ref_case, 0, &bs->cs, NULL) != 0 ||
+            load_last(&ref_case, &ref) != 0) {
+            CHECK_MSG(0, "%s: the serial run", bs->tag);
+            tc_case_destroy(&ref_case);
+            continue;
+        }
+        const double l0 = ref.l0;
+        check_serial_bodies(bs, &ref_case, l0);
+        for (int np = 2; np <= 3; np++) {
+            char what[96];
+            snprintf(tag, sizeof tag, "bodies-%s-np%d", bs->tag, np);
+            snprintf(what, sizeof what, "%s on %d ranks", bs->tag, np);
+            tc_case c;
+            mf_sim got;
+            memset(&got, 0, sizeof got);
+            if (make_body_case(&c, bs, tag) == 0 && run(&c, np, &bs->cs, NULL) == 0 &&
+                load_last(&c, &got) == 0) {
+                compare(what, &ref, &got, l0, INT64_MAX);
+                for (int b = 0; b < 2 && bs->bodies[b].name; b++)
+                    compare_body(what, &ref_case, &c, bs->bodies[b].name, l0,
+                                 (int)bs->steps + 1);
+            } else {
+                CHECK_MSG(0, "%s: the run", what);
+            }
+            tc_sim_free(&got);
+            tc_case_destroy(&c);
+        }
+        tc_sim_free(&ref);
+        tc_case_destroy(&ref_case);
+    }
+}
+
+static void part_bodies(void)
+{
+    part_floating_box();
+    part_body_paths();
 }
 
 /* "Load imbalance X, after rebalancing Y" from the log. */
@@ -484,7 +819,7 @@ static void part_balance(void)
 int main(int argc, char **argv)
 {
     if (argc < 4) {
-        fprintf(stderr, "usage: test_mpi MPSFLOW TUTORIALS cases|restart|balance\n");
+        fprintf(stderr, "usage: test_mpi MPSFLOW TUTORIALS cases|restart|balance|bodies\n");
         return 2;
     }
     exe = argv[1];
@@ -514,6 +849,8 @@ int main(int argc, char **argv)
         part_restart();
     else if (!strcmp(argv[3], "balance"))
         part_balance();
+    else if (!strcmp(argv[3], "bodies"))
+        part_bodies();
     else
         return 2;
     return mf_test_summary(argv[3]);

@@ -139,6 +139,11 @@ void mf_parallel_argmax(const mf_parallel *par, double *value, const mf_particle
 void mf_parallel_bcast(const mf_parallel *par, void *buf, size_t bytes, int root);
 /* bytes from each rank, concatenated in rank order into all (size * bytes). */
 void mf_parallel_allgather(const mf_parallel *par, const void *mine, size_t bytes, void *all);
+/* bytes (this rank's, any number) from each rank, concatenated in rank
+ * order into a new buffer *all (free it) of *total bytes; one rank: a copy.
+ * Collective. */
+int mf_parallel_allgatherv(const mf_parallel *par, const void *mine, size_t bytes, void **all,
+                           size_t *total);
 /* Collective: 0 when rc is 0 on every rank; otherwise this rank's rc (its
  * message already recorded) or, on a rank that did not fail itself, the
  * most severe status of the others with a message naming the rank that

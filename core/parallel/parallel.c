@@ -191,6 +191,38 @@ void mf_parallel_allgather(const mf_parallel *par, const void *mine, size_t byte
     MPI_Allgather(mine, (int)bytes, MPI_BYTE, all, (int)bytes, MPI_BYTE, par->comm);
 }
 
+int mf_parallel_allgatherv(const mf_parallel *par, const void *mine, size_t bytes, void **all,
+                           size_t *total)
+{
+    const int size = par ? par->size : 1;
+    int *counts = malloc(2 * (size_t)size * sizeof *counts);
+    if (!counts)
+        return MF_ERROR(MF_ERR_MEMORY, "out of memory gathering from the ranks");
+    int *displs = counts + size;
+    const int mine_count = (int)bytes;
+    if (par)
+        MPI_Allgather(&mine_count, 1, MPI_INT, counts, 1, MPI_INT, par->comm);
+    else
+        counts[0] = mine_count;
+    size_t sum = 0;
+    for (int r = 0; r < size; r++) {
+        displs[r] = (int)sum;
+        sum += (size_t)counts[r];
+    }
+    *all = malloc(sum ? sum : 1);
+    if (!*all) {
+        free(counts);
+        return MF_ERROR(MF_ERR_MEMORY, "out of memory gathering %zu bytes from the ranks", sum);
+    }
+    if (par)
+        MPI_Allgatherv(mine, mine_count, MPI_BYTE, *all, counts, displs, MPI_BYTE, par->comm);
+    else if (bytes)
+        memcpy(*all, mine, bytes);
+    *total = sum;
+    free(counts);
+    return 0;
+}
+
 /* Severity of a status, for choosing whose failure every rank reports:
  * a fatal error above a retry above success. */
 static int severity(int rc)

@@ -27,26 +27,90 @@
 #include <string.h>
 
 #include "mf_error.h"
+#include "mf_parallel.h"
 
 #include "bodies_internal.h"
 #include "mf_mat3.h"
+
+/* The outer (wall) particles of the bodies where the committed state has
+ * them, gathered from every rank (each owns some), so that every rank sweeps
+ * the same points in the same order and reaches the same trial states; on
+ * one rank in the particles' order, on several sorted by (body, id). */
+typedef struct body_point {
+    int64_t id;
+    int64_t body; /* the body's place in ws */
+    double x[3];
+} body_point;
+
+typedef struct body_points {
+    body_point *pt;
+    size_t n;
+} body_points;
+
+static int cmp_point(const void *a, const void *b)
+{
+    const body_point *u = a, *v = b;
+    if (u->body != v->body)
+        return u->body < v->body ? -1 : 1;
+    return (u->id > v->id) - (u->id < v->id);
+}
+
+/* Particle i is an outer particle of a body (id: the WallId field). */
+static bool is_body_point(const mf_walls *ws, const mf_particles *p, const int32_t *id, size_t i)
+{
+    return id[i] > 0 && (size_t)id[i] <= ws->n && ws->w[id[i] - 1].body &&
+           p->kind[i] == MF_WALL;
+}
+
+static int gather_points(const mf_walls *ws, const mf_particles *p, body_points *out)
+{
+    const int32_t *id = mf_particles_fi(p, ws->f_wall_id);
+    size_t n = 0;
+    for (size_t i = 0; i < p->n_owned; i++)
+        n += is_body_point(ws, p, id, i);
+    body_point *mine = malloc((n ? n : 1) * sizeof *mine);
+    if (!mine)
+        return MF_ERROR(MF_ERR_MEMORY, "out of memory for the rigid bodies' contacts");
+    n = 0;
+    for (size_t i = 0; i < p->n_owned; i++) {
+        if (!is_body_point(ws, p, id, i))
+            continue;
+        mine[n].id = p->id[i];
+        mine[n].body = id[i] - 1;
+        memcpy(mine[n].x, &p->pos[3 * i], sizeof mine[n].x);
+        n++;
+    }
+    if (!ws->par) {
+        out->pt = mine;
+        out->n = n;
+        return 0;
+    }
+    void *all = NULL;
+    size_t bytes = 0;
+    const int rc = mf_parallel_allgatherv(ws->par, mine, n * sizeof *mine, &all, &bytes);
+    free(mine);
+    MF_CALL(rc);
+    out->pt = all;
+    out->n = bytes / sizeof *out->pt;
+    qsort(out->pt, out->n, sizeof *out->pt, cmp_point);
+    return 0;
+}
 
 /* The overlap of body A's outer particles with solid B at the trial
  * states: returns the deepest delta (<= 0: none), and the overlapping
  * particles' mean trial position and mean normal of B, weighted by their
  * overlap (a face resting flat on a plane: its middle, so that the impulse
  * there stops the body without turning it). */
-static double overlap(const mf_walls *ws, const mf_particles *p, size_t ka, const mf_wall *B,
+static double overlap(const mf_walls *ws, const body_points *p, size_t ka, const mf_wall *B,
                       double xc[3], double nc[3])
 {
     const mf_wall *A = &ws->w[ka];
     const mf_body *a = A->body;
-    const int32_t *id = mf_particles_fi(p, ws->f_wall_id);
     double best = 0, sw = 0, sx[3] = {0, 0, 0}, sn[3] = {0, 0, 0};
-    for (size_t i = 0; i < p->n_owned; i++) {
-        if (id[i] != (int32_t)ka + 1 || p->kind[i] != MF_WALL)
+    for (size_t i = 0; i < p->n; i++) {
+        if (p->pt[i].body != (int64_t)ka)
             continue;
-        const double *x = &p->pos[3 * i];
+        const double *x = p->pt[i].x;
         const double r[3] = {x[0] - a->x[0], x[1] - a->x[1], x[2] - a->x[2]};
         double rb[3], rt[3], xt[3], n[3];
         mf_mat3_t_vec(a->R, r, rb); /* body axes */
@@ -129,18 +193,17 @@ static void shift(mf_wall *w, int dim, const double s[3])
  * approach at the first sweep), its total lam[i] over the sweeps kept >= 0
  * (a contact pushes, never pulls: Catto's accumulated clamping). Returns
  * the largest change of an impulse, N s (2-D: per metre). */
-static double sweep(mf_walls *ws, const mf_particles *p, size_t ka, size_t kb, double e,
+static double sweep(mf_walls *ws, const body_points *p, size_t ka, size_t kb, double e,
                     double dt, bool first, double *lam, double *target, double *normal)
 {
     mf_wall *A = &ws->w[ka], *B = &ws->w[kb];
     const int dim = ws->dim;
-    const int32_t *id = mf_particles_fi(p, ws->f_wall_id);
     double change = 0;
-    for (size_t i = 0; i < p->n_owned; i++) {
-        if (id[i] != (int32_t)ka + 1 || p->kind[i] != MF_WALL)
+    for (size_t i = 0; i < p->n; i++) {
+        if (p->pt[i].body != (int64_t)ka)
             continue;
         mf_body *a = A->body, *b = B->body;
-        const double *x0 = &p->pos[3 * i];
+        const double *x0 = p->pt[i].x;
         const double r[3] = {x0[0] - a->x[0], x0[1] - a->x[1], x0[2] - a->x[2]};
         double rb[3], rt[3], x[3], n[3];
         mf_mat3_t_vec(a->R, r, rb);
@@ -182,7 +245,7 @@ static double sweep(mf_walls *ws, const mf_particles *p, size_t ka, size_t kb, d
     return change;
 }
 
-static void contact_pair(mf_walls *ws, const mf_particles *p, size_t ka, size_t kb, double dt,
+static void contact_pair(mf_walls *ws, const body_points *p, size_t ka, size_t kb, double dt,
                          bool bounce, double *lam, double *target, double *normal)
 {
     mf_wall *A = &ws->w[ka], *B = &ws->w[kb];
@@ -220,13 +283,16 @@ int mf_bodies_contact(mf_walls *ws, const mf_particles *p, double dt)
 {
     if (ws->f_wall_id < 0 || !ws->particles || mf_bodies_count(ws) == 0)
         return 0;
-    const size_t n = p->n_owned ? p->n_owned : 1;
+    body_points pts = {NULL, 0};
+    MF_CALL(gather_points(ws, p, &pts));
+    const size_t n = pts.n ? pts.n : 1;
     double *lam = malloc(n * sizeof *lam), *target = malloc(n * sizeof *target);
     double *normal = malloc(3 * n * sizeof *normal);
     if (!lam || !target || !normal) {
         free(lam);
         free(target);
         free(normal);
+        free(pts.pt);
         return MF_ERROR(MF_ERR_MEMORY, "out of memory for the rigid bodies' contacts");
     }
     /* every pair, CONTACT_PASSES times: what one pair's impulses do to a
@@ -238,8 +304,9 @@ int mf_bodies_contact(mf_walls *ws, const mf_particles *p, double dt)
                 continue;
             for (size_t kb = 0; kb < ws->n; kb++)
                 if (kb != ka)
-                    contact_pair(ws, p, ka, kb, dt, pass == 0, lam, target, normal);
+                    contact_pair(ws, &pts, ka, kb, dt, pass == 0, lam, target, normal);
         }
+    free(pts.pt);
     free(lam);
     free(target);
     free(normal);

@@ -59,13 +59,14 @@ void mf_body_add_force(mf_wall *w, const double x[3], const double f[3]);
 
 /* The surface the body's wall particles (kind MF_WALL) stand for, for the
  * pressure force: prepare counts the wall particles within l0 of each face
- * (index: the body's place in ws, its WallId less one); mf_body_surface
+ * (index: the body's place in ws, its WallId less one; over every rank of
+ * par, collective, NULL: one rank); mf_body_surface
  * gives, for the wall particle at world point x, up to 3 surface elements
  * (a box's edge or corner particle stands for 2 or 3 faces): the outward
  * area vectors A n (m^2; 2-D: m per metre) and the shifts from x to the
  * surface along n. Returns how many. */
 int mf_body_surface_prepare(mf_wall *w, const mf_particles *p, int f_wall_id, int index,
-                            double l0);
+                            double l0, const struct mf_parallel *par);
 int mf_body_surface(const mf_wall *w, const double x[3], double l0, double out_area[3][3],
                     double out_shift[3][3]);
 

@@ -123,6 +123,9 @@ typedef struct mf_walls {
     mf_wall *w;
     bool particles;       /* the solids are particles (wall, dummy), else none */
     int f_wall_id;        /* "WallId" field of the particles of moving solids, -1: none */
+    /* The ranks of a -parallel run (NULL: one): the rigid bodies' sums over
+     * their particles are taken over all of them (mf_bodies.h). */
+    const struct mf_parallel *par;
 } mf_walls;
 
 int mf_walls_create(int dim, double l0, bool particles, mf_walls **out);

@@ -13,6 +13,7 @@
 #include "mf_error.h"
 #include "mf_mat3.h"
 #include "mf_fs.h"
+#include "mf_parallel.h"
 #include "bodies_internal.h"
 
 
@@ -308,8 +309,47 @@ static void write_row(const mf_wall *w, double t)
     fflush(b->csv);
 }
 
+/* On several ranks each rank summed the fluid's force and torque over its
+ * owned particles: the sums over all ranks, the same on every rank, so that
+ * every rank integrates the same body state. */
+static int reduce_forces(mf_walls *ws)
+{
+    const size_t nb = mf_bodies_count(ws);
+    if (!ws || !ws->par || nb == 0)
+        return 0;
+    double *sum = malloc(6 * nb * sizeof *sum);
+    if (!sum)
+        return MF_ERROR(MF_ERR_MEMORY, "out of memory summing the rigid bodies' forces");
+    size_t m = 0;
+    for (size_t k = 0; k < ws->n; k++)
+        if (ws->w[k].body) {
+            for (int c = 0; c < 3; c++) {
+                sum[m + c] = ws->w[k].force[c];
+                sum[m + 3 + c] = ws->w[k].torque[c];
+            }
+            m += 6;
+        }
+    mf_parallel_sum(ws->par, sum, (int)(6 * nb));
+    /* MPI does not promise every rank the same rounding of a sum (the order
+     * of its additions may differ by rank): rank 0's, so that no rank's body
+     * drifts from the others' */
+    mf_parallel_bcast(ws->par, sum, 6 * nb * sizeof *sum, 0);
+    m = 0;
+    for (size_t k = 0; k < ws->n; k++)
+        if (ws->w[k].body) {
+            for (int c = 0; c < 3; c++) {
+                ws->w[k].force[c] = sum[m + c];
+                ws->w[k].torque[c] = sum[m + 3 + c];
+            }
+            m += 6;
+        }
+    free(sum);
+    return 0;
+}
+
 int mf_bodies_accept(mf_walls *ws, double t, double dt)
 {
+    MF_CALL(reduce_forces(ws));
     for (size_t k = 0; ws && k < ws->n; k++) {
         mf_wall *w = &ws->w[k];
         mf_body *b = w->body;
@@ -460,7 +500,7 @@ static void face_depths(const mf_wall *w, int dim, const double xb[3], double de
 }
 
 int mf_body_surface_prepare(mf_wall *w, const mf_particles *p, int f_wall_id, int index,
-                            double l0)
+                            double l0, const struct mf_parallel *par)
 {
     mf_body *b = w->body;
     if (b->surface_ready)
@@ -478,6 +518,11 @@ int mf_body_surface_prepare(mf_wall *w, const mf_particles *p, int f_wall_id, in
         for (int f = 0; f < 2 * dim; f++)
             count[f] += depth[f] < l0;
     }
+    /* the counts over every rank's owned particles (whole numbers: exact) */
+    double counts[7] = {count[0], count[1], count[2], count[3], count[4], count[5], nround};
+    mf_parallel_sum(par, counts, 7);
+    memcpy(count, counts, sizeof count);
+    nround = counts[6];
     if (w->shape == MF_SOLID_BOX) {
         for (int f = 0; f < 2 * dim; f++) {
             double area = 1;

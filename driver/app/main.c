@@ -223,11 +223,10 @@ static int run_case(mf_app *app)
     bool restart = mf_app_is_restart(app);
     const bool bodies = mf_bodies_count(app->sim.walls) > 0;
     if (bodies) {
-        /* Rigid bodies (mf_bodies.h): one rank; time 0 or a restart, whose
-         * snapshot holds their state (/RigidBodies). */
-        if (app->sim.par)
-            return MF_ERROR(MF_ERR_INPUT, "rigid bodies (motion type rigid) run on one rank only "
-                            "for now: run without -parallel");
+        /* Rigid bodies (mf_bodies.h): time 0 or a restart, whose snapshot
+         * holds their state (/RigidBodies); on several ranks their sums are
+         * taken over all (mf_walls.par). */
+        app->sim.walls->par = app->sim.par;
         if (!restart && app->sim.time != 0)
             return MF_ERROR(MF_ERR_INPUT, "rigid bodies (motion type rigid) start at time 0 or "
                             "restart from a snapshot (startFrom latestTime, -latestTime): their "
@@ -247,7 +246,12 @@ static int run_case(mf_app *app)
     if (bodies) {
         char post[4400];
         snprintf(post, sizeof post, "%s/postProcessing", app->cs.dir);
-        MF_CALL(mf_bodies_open_output(app->sim.walls, post, app->sim.time, restart));
+        /* bodyState.csv: rank 0 writes it (every rank has the same state) */
+        MF_CALL(mf_parallel_agree(app->sim.par,
+                                  mf_parallel_is_root(app->sim.par)
+                                      ? mf_bodies_open_output(app->sim.walls, post,
+                                                              app->sim.time, restart)
+                                      : 0));
     }
     MF_CALL(mf_parallel_agree(app->sim.par, mf_app_distribute(app)));
     if (mf_parallel_is_root(app->sim.par))

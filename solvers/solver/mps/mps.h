@@ -328,6 +328,8 @@ int mps_source_terms(mps_data *d, const mf_sim *sim, double dt);
  * (explicit phase, lists at r^n), the pressure share (correction phase,
  * lists at r*). Nothing without a rigid body; a clear error where the
  * step's sums do not split over pairs or on several ranks. */
+/* The bodies' WallId field into the halo copies (after mps_halo_create). */
+int mps_bodies_halo(mps_data *d, const mf_sim *sim);
 void mps_bodies_begin(mps_data *d, mf_sim *sim);
 int mps_bodies_viscous(mps_data *d, mf_sim *sim);
 int mps_bodies_pressure(mps_data *d, mf_sim *sim, const double *pressure);
@@ -347,6 +349,12 @@ int mps_solve_ppe(mps_data *d, mf_sim *sim);
  * only); p of non-dummy neighbours. */
 int mps_gradient_pairs(mps_data *d, const mf_sim *sim, const double *pressure,
                        const uint8_t *imask);
+/* The corrected gradient's p^ (CMPS: eq. 5's neighbourhood minimum, always)
+ * of every particle the sums over v read, into fhat (p->n): the owned
+ * particles' from their neighbours, the halo copies' their owners' (a
+ * copy's own neighbourhood is incomplete). */
+int mps_corrected_pmin(const mps_data *d, const mf_sim *sim, const mf_pairs *v,
+                       const double *pressure, double *fhat);
 /* eqs. 16-17 for those particles: u' = -dt grad, u += u', r += dt u'.
  * Returns max |u'|. */
 double mps_apply_correction(mps_data *d, mf_particles *p, double dt, const uint8_t *imask);

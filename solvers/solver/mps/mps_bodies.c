@@ -34,13 +34,13 @@
 #include "mf_operators.h"
 #include "mps.h"
 
-/* Rigid bodies work on one rank, without a period, with one fluid and the
- * operators whose sums split over pairs. */
+/* Rigid bodies work on any number of ranks (each sums over its owned
+ * particles, mf_bodies_accept sums over the ranks), without a period, with
+ * one fluid and the operators whose sums split over pairs. */
 static int check(const mps_data *d, const mf_sim *sim)
 {
-    const char *why = d->halo ? (sim->par ? "on several ranks (the body's force would need its "
-                                            "particles' halo copies: run on one rank)"
-                                          : "with a periodic box")
+    (void)sim;
+    const char *why = d->s.periodic_length > 0 ? "with a periodic box"
                       : d->rho || d->mu ? "with several fluids"
                       : d->visc         ? "with implicit viscosity (use viscosity explicit)"
                       : d->sc.laplacian == MPS_LAPLACIAN_LEAST_SQUARES
@@ -101,6 +101,17 @@ static void scratch_free(scratch *s)
     free(s->acc);
 }
 
+int mps_bodies_halo(mps_data *d, const mf_sim *sim)
+{
+    const mf_walls *ws = sim->walls;
+    if (mf_bodies_count(ws) == 0 || ws->f_wall_id < 0)
+        return 0;
+    /* body_mask reads the WallId of the neighbours, copies included: at r^n
+     * (viscosity) and at r* (the corrected gradient's pairs) */
+    MF_CALL(mps_halo_add_field(d, ws->f_wall_id, MPS_HALO_START | MPS_HALO_STAR));
+    return 0;
+}
+
 void mps_bodies_begin(mps_data *d, mf_sim *sim)
 {
     (void)d;
@@ -152,8 +163,14 @@ static int pressure_pairs(mps_data *d, mf_sim *sim, const double *pressure)
         scratch_free(&s);
         return MF_ERROR(MF_ERR_MEMORY, "out of memory summing the forces on the rigid bodies");
     }
-    /* p^ as the step's gradient has it (mps_gradient_pairs) */
-    mf_neighbour_min(&v, pressure, true, d->own_reference, d->not_dummy, d->not_dummy, fhat);
+    /* p^ as the step's gradient has it (mps_gradient_pairs), the halo
+     * copies' included: the pair term reads p^ of both particles */
+    const int rc = mps_corrected_pmin(d, sim, &v, pressure, fhat);
+    if (rc != 0) {
+        free(fhat);
+        scratch_free(&s);
+        return mf_error_trace(rc, __FILE__, __LINE__, __func__);
+    }
     const mf_gradient_opts o = {.f = pressure, .coef = 1.0 / sim->fluid[0].rho, .fhat = fhat};
     for (size_t k = 0; k < ws->n; k++) {
         if (!ws->w[k].body)
@@ -230,7 +247,7 @@ static int pressure_surface(mps_data *d, mf_sim *sim, const double *pressure)
         mf_wall *w = &ws->w[k];
         if (!w->body)
             continue;
-        MF_CALL(mf_body_surface_prepare(w, p, ws->f_wall_id, (int)k, l0));
+        MF_CALL(mf_body_surface_prepare(w, p, ws->f_wall_id, (int)k, l0, sim->par));
         double ga[3];
         for (int a = 0; a < 3; a++)
             ga[a] = w->motion.g[a] - w->state.a[a];

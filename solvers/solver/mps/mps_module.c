@@ -164,6 +164,7 @@ int mps_create_data(const mps_settings *s, mf_sim *sim, const mf_dict *solver_di
     }
     MF_CALL(mps_reserve(d, sim->p->n));
     MF_CALL(mps_halo_create(d, sim)); /* copies from other ranks (none in a serial run) */
+    MF_CALL(mps_bodies_halo(d, sim));
     const mf_kernel *ks[3] = {&d->k_nd, &d->k_grad, &d->k_lap};
     const char *names[3] = {"number density", "gradient", "Laplacian"};
     for (int k = 0; k < 3; k++)
@@ -225,6 +226,8 @@ static int mps_create(const void *settings, mf_sim *sim, const mf_dict *solver_d
         d->halo = NULL;
         d->s.periodic_length = period;
         rc = mps_halo_create(d, sim);
+        if (rc == 0)
+            rc = mps_bodies_halo(d, sim);
     }
     if (rc == 0) { /* wall wallWeight: the walls' terms (mps_wall.c) */
         d->s.wall = wall;

@@ -35,6 +35,14 @@ static int least_squares(mps_data *d, const mf_sim *sim, const mf_pairs *v,
     return 0;
 }
 
+int mps_corrected_pmin(const mps_data *d, const mf_sim *sim, const mf_pairs *v,
+                       const double *pressure, double *fhat)
+{
+    mf_neighbour_min(v, pressure, true, d->own_reference, d->not_dummy, d->not_dummy, fhat);
+    MF_CALL(mps_halo_sync(d, sim, fhat, sizeof *fhat)); /* copies: their owners' p^ */
+    return 0;
+}
+
 /* eq. 15 with 1/rho_ij inside the gradient sum (eq. 5): the same pair
  * coefficient as the PPE, so the correction is the one the PPE solved for
  * (1/rho with one fluid, rho NULL). */
@@ -55,12 +63,9 @@ int mps_gradient_pairs(mps_data *d, const mf_sim *sim, const double *pressure,
     if (d->sc.gradient == MPS_GRADIENT_LEAST_SQUARES)
         return least_squares(d, sim, &v, &o, im);
     if (d->sc.gradient == MPS_GRADIENT_CORRECTED) {
-        /* p^ of every particle the sums read (eq. 5's p_min, always) */
         MF_CALL(mps_scheme_reserve(d, sim->p->n));
-        double *fhat = d->work;
-        mf_neighbour_min(&v, pressure, true, d->own_reference, d->not_dummy, d->not_dummy, fhat);
-        MF_CALL(mps_halo_sync(d, sim, fhat, sizeof *fhat)); /* copies: their owners' p^ */
-        o.fhat = fhat;
+        MF_CALL(mps_corrected_pmin(d, sim, &v, pressure, d->work));
+        o.fhat = d->work;
     }
     mf_gradient_ex(&v, &d->k_grad, &o, im, d->not_dummy, d->grad);
     return 0;
