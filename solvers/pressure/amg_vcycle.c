@@ -422,7 +422,8 @@ static int copy_matrix(mf_split_csr *s, hypre_ParCSRMatrix *A)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory copying a level of %d rows", n);
     for (HYPRE_Int i = 0; i <= n; i++)
         rp[i] = (size_t)I[i];
-    const mf_csr c = {(size_t)n, 0, n, rp, hypre_CSRMatrixJ(D), hypre_CSRMatrixData(D), 0};
+    const mf_csr c = {.nrows = (size_t)n, .nglobal = n, .rowptr = rp,
+                      .col = hypre_CSRMatrixJ(D), .val = hypre_CSRMatrixData(D)};
     int rc = mf_split_csr_set(s, &c);
     free(rp);
     return rc;
