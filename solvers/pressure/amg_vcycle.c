@@ -26,6 +26,25 @@ extern void dgetrs_(const char *trans, const int *n, const int *nrhs, const doub
 
 /* ---- the split matrix -------------------------------------------------- */
 
+/* Columns and values with room for need + 1 entries: grown when *cap is
+ * below need or nothing is there yet (*cap then need). False when out of
+ * memory (what was there stays, *cap unchanged). */
+static bool grow_entries(int32_t **col, double **val, size_t *cap, size_t need)
+{
+    if (need <= *cap && *col != NULL)
+        return true;
+    int32_t *c = realloc(*col, (need + 1) * sizeof *c);
+    if (c)
+        *col = c;
+    double *v = realloc(*val, (need + 1) * sizeof *v);
+    if (v)
+        *val = v;
+    if (!c || !v)
+        return false;
+    *cap = need;
+    return true;
+}
+
 static int split_reserve(mf_split_csr *s, size_t n, size_t nnz)
 {
     if (n > s->cap_rows) {
@@ -45,17 +64,8 @@ static int split_reserve(mf_split_csr *s, size_t n, size_t nnz)
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for a matrix of %zu rows", n);
         s->cap_rows = n;
     }
-    if (nnz > s->cap_nnz || s->col_buf == NULL) {
-        int32_t *col = realloc(s->col_buf, (nnz + 1) * sizeof *col);
-        if (col)
-            s->col_buf = col;
-        double *val = realloc(s->val_buf, (nnz + 1) * sizeof *val);
-        if (val)
-            s->val_buf = val;
-        if (!col || !val)
-            return MF_ERROR(MF_ERR_MEMORY, "out of memory for a matrix of %zu non-zeros", nnz);
-        s->cap_nnz = nnz;
-    }
+    if (!grow_entries(&s->col_buf, &s->val_buf, &s->cap_nnz, nnz))
+        return MF_ERROR(MF_ERR_MEMORY, "out of memory for a matrix of %zu non-zeros", nnz);
     return 0;
 }
 
@@ -131,17 +141,8 @@ static int split_reserve_lent(mf_split_csr *s, size_t nnz, size_t longest)
         s->upper = u;
         s->cap_upper = words;
     }
-    if (longest + 1 > s->cap_row) {
-        int32_t *c = realloc(s->row_buf, (longest + 1) * sizeof *c);
-        if (c)
-            s->row_buf = c;
-        double *v = realloc(s->row_val, (longest + 1) * sizeof *v);
-        if (v)
-            s->row_val = v;
-        if (!c || !v)
-            return MF_ERROR(MF_ERR_MEMORY, "out of memory for a row of %zu entries", longest);
-        s->cap_row = longest + 1;
-    }
+    if (!grow_entries(&s->row_buf, &s->row_val, &s->cap_row, longest + 1))
+        return MF_ERROR(MF_ERR_MEMORY, "out of memory for a row of %zu entries", longest);
     return 0;
 }
 
