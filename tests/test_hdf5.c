@@ -297,6 +297,44 @@ static void check_file_content(const char *path, int dim)
     H5Fclose(file);
 }
 
+/* The file as HDF5 itself would hand out its image (H5Fget_file_image, which
+ * the writer no longer calls, to hold the image once): opened read-only in
+ * memory, its image must be the file byte for byte, so the writer wrote
+ * exactly the image's length and cleared the superblock's consistency flags
+ * (bytes 20-23 of a version 0 superblock), set in the writer's open file. */
+static void check_image(const char *path)
+{
+    char *bytes = NULL;
+    FILE *f = fopen(path, "rb");
+    CHECK(f != NULL);
+    if (!f)
+        return;
+    fseek(f, 0, SEEK_END);
+    long size = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    bytes = size > 24 ? malloc((size_t)size) : NULL;
+    CHECK(bytes && fread(bytes, 1, (size_t)size, f) == (size_t)size);
+    fclose(f);
+    if (!bytes)
+        return;
+    CHECK(bytes[8] == 0); /* superblock version 0 */
+    CHECK(bytes[20] == 0 && bytes[21] == 0 && bytes[22] == 0 && bytes[23] == 0);
+    hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+    CHECK(fapl >= 0 && H5Pset_fapl_core(fapl, (size_t)1 << 20, 0) >= 0);
+    hid_t file = H5Fopen(path, H5F_ACC_RDONLY, fapl);
+    CHECK(file >= 0);
+    ssize_t n = file >= 0 ? H5Fget_file_image(file, NULL, 0) : -1;
+    CHECK(n == size);
+    char *image = n == size ? malloc((size_t)n) : NULL;
+    CHECK(image && H5Fget_file_image(file, image, (size_t)n) == n &&
+          memcmp(image, bytes, (size_t)n) == 0);
+    free(image);
+    free(bytes);
+    if (file >= 0)
+        H5Fclose(file);
+    H5Pclose(fapl);
+}
+
 static void check_h5dump(const char *path)
 {
     if (access("/usr/bin/h5dump", X_OK) != 0) {
@@ -448,6 +486,7 @@ static void test_roundtrip(int dim, long compression)
     CHECK(file_exists(path));
     check_file_content(path, dim);
     check_h5dump(path);
+    check_image(path);
     check_xdmf(output_dir, 2);
     check_no_open_handles("after checking the files");
 

@@ -756,6 +756,29 @@ static void test_split_view(void)
     CHECK_OK(mf_split_csr_fine(&view, &A));
     CHECK_MSG(view.gap == 0 && view.col != col, "a row out of order must make a copy");
     mf_split_csr_free(&view);
+    /* The same rows lent: split in them, the copy's layout, and put back. */
+    int32_t col0[sizeof col / sizeof *col];
+    double val0[sizeof val / sizeof *val];
+    memcpy(col0, col, sizeof col);
+    memcpy(val0, val, sizeof val);
+    A.lent_capacity = k;
+    mf_split_csr_free(&copy);
+    CHECK_OK(mf_split_csr_set(&copy, &A));
+    CHECK_OK(mf_split_csr_fine(&view, &A));
+    CHECK_MSG(view.gap == 1 && view.col == col, "lent rows: the split should be made in them");
+    for (int32_t i = 0; i < N; i++) {
+        const int32_t len = mf_split_end(&copy, i) - copy.ptr[i];
+        bad += mf_split_end(&view, i) - view.ptr[i] != len ||
+               view.mid[i] - view.ptr[i] != copy.mid[i] - copy.ptr[i];
+        for (int32_t e = 0; e < len && bad == 0; e++)
+            bad += view.col[view.ptr[i] + e] != copy.col[copy.ptr[i] + e] ||
+                   view.val[view.ptr[i] + e] != copy.val[copy.ptr[i] + e];
+    }
+    CHECK_MSG(bad == 0, "the split in place differs from the copy in %zu rows", bad);
+    mf_split_csr_restore(&view);
+    CHECK_MSG(memcmp(col, col0, sizeof col) == 0 && memcmp(val, val0, sizeof val) == 0,
+              "the rows lent for the split did not come back as they were");
+    mf_split_csr_free(&view);
     mf_split_csr_free(&copy);
 }
 
@@ -805,6 +828,15 @@ static void test_split_layout(void)
     CHECK_MSG(bad == 0, "the split layout differs from the rows in %zu places", bad);
     CHECK(sp.ptr[18] - sp.ptr[17] == N - 1); /* the long row: every column but its own */
     mf_split_csr_free(&sp);
+    /* Lent, but rows with their diagonal last and twice: a copy, the rows
+     * untouched. */
+    int32_t *col0 = malloc(k * sizeof *col0);
+    memcpy(col0, col, k * sizeof *col0);
+    A.lent_capacity = k;
+    CHECK_OK(mf_split_csr_fine(&sp, &A));
+    CHECK(sp.gap == 0 && memcmp(col0, col, k * sizeof *col0) == 0);
+    mf_split_csr_free(&sp);
+    free(col0);
     free(col);
     free(val);
 }

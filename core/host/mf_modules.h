@@ -48,7 +48,10 @@ typedef struct mf_solver_ops {
  * indices; this rank owns rows [row_offset, row_offset + nrows). Columns are
  * 32-bit, as the hypre of the platform's packages (HYPRE_BigInt is int
  * without --enable-bigint): the matrix is the largest array of a run, and a
- * system has fewer than 2^31 unknowns in all. */
+ * system has fewer than 2^31 unknowns in all.
+ * Callers zero-initialise an mf_csr (a designated initialiser, calloc, or
+ * memset) before filling it: fields added at its end (lent_capacity) must
+ * read 0, "nothing lent", wherever a caller does not know of them. */
 typedef struct mf_csr {
     size_t nrows;
     int64_t row_offset;

@@ -47,6 +47,10 @@ int mf_force_accumulate(mf_sim *sim, double *acc)
         return 0;
     int fa = 0;
     MF_CALL(mf_particles_request_field(p, MF_FORCE_FIELD, 3, MF_FIELD_DOUBLE, false, &fa));
+    /* Zeroed here and summed by the forces at every step; read only after
+     * (mf_watch_check, while forces_record.valid, which each attempt clears
+     * first): a retry needs no copy of it. */
+    MF_CALL(mf_particles_set_step_scratch(p, fa));
     double *a = mf_particles_fd(p, fa);
     memset(a, 0, 3 * p->n * sizeof *a);
     for (size_t k = 0; k < sim->nforces; k++) {

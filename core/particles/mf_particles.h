@@ -43,6 +43,8 @@ typedef struct mf_field {
     int type;         /* MF_FIELD_DOUBLE or MF_FIELD_INT32 */
     void *data;       /* ncomp * cap elements */
     bool output;      /* written to snapshots */
+    bool step_scratch; /* written in full by every step before it is read:
+                          a failed step's retry need not save it (run.c) */
 } mf_field;
 
 enum { MF_FIELD_DOUBLE = 0, MF_FIELD_INT32 = 1 };
@@ -90,6 +92,11 @@ int mf_particles_permute(mf_particles *p, const size_t *perm);
 int mf_particles_request_field(mf_particles *p, const char *name, int ncomp, int type,
                                bool output, int *index);
 int mf_particles_field_index(const mf_particles *p, const char *name); /* -1 if absent */
+/* Say that field index is rewritten in full by every step before anything
+ * reads it (a scratch of the step, such as the forces' accelerations):
+ * the time loop then keeps no copy of it to retry a failed step. One
+ * requester saying so is enough; it must hold for every reader. */
+int mf_particles_set_step_scratch(mf_particles *p, int index);
 static inline double *mf_particles_fd(const mf_particles *p, int index)
 {
     return (double *)p->field[index].data;

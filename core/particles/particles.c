@@ -340,6 +340,14 @@ int mf_particles_field_index(const mf_particles *p, const char *name)
     return -1;
 }
 
+int mf_particles_set_step_scratch(mf_particles *p, int index)
+{
+    if (!p || index < 0 || index >= p->nfields)
+        return MF_ERROR(MF_ERR_INTERNAL, "mf_particles_set_step_scratch: no field %d", index);
+    p->field[index].step_scratch = true;
+    return 0;
+}
+
 int mf_particles_request_field(mf_particles *p, const char *name, int ncomp, int type,
                                bool output, int *index)
 {

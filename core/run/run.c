@@ -22,7 +22,10 @@ size_t mf_peak_memory(void)
     return (size_t)ru.ru_maxrss * 1024u; /* Linux reports KiB */
 }
 
-/* ---- a copy of the particles to go back to when a step fails ---------- */
+/* ---- a copy of the particles to go back to when a step fails ----------
+ * Every array but the fields a step writes in full before reading them
+ * (mf_field.step_scratch): those are left as the failed attempt had them,
+ * and the retry writes them again. */
 typedef struct saved_state {
     size_t n, n_owned, cap;
     double *pos, *vel;
@@ -46,17 +49,18 @@ static int save_state(saved_state *s, const mf_particles *p, double time)
                      mf_resize(&s->kind, cap, 1) == 0 &&
                      mf_resize(&s->id, cap, sizeof(int64_t)) == 0;
         for (int f = 0; grown && f < p->nfields; f++)
-            grown = mf_resize(&s->field[f], field_bytes(&p->field[f], cap), 1) == 0;
+            if (!p->field[f].step_scratch)
+                grown = mf_resize(&s->field[f], field_bytes(&p->field[f], cap), 1) == 0;
         if (!grown)
             return MF_ERROR(MF_ERR_MEMORY, "out of memory saving the state of step");
         s->cap = cap;
     }
     for (int f = 0; f < p->nfields; f++)
-        if (!s->field[f])
+        if (!s->field[f] && !p->field[f].step_scratch)
             s->field[f] = malloc(field_bytes(&p->field[f], s->cap));
     bool ok = s->pos && s->vel && s->kind && s->id;
     for (int f = 0; f < p->nfields; f++)
-        ok = ok && s->field[f];
+        ok = ok && (s->field[f] || p->field[f].step_scratch);
     if (!ok)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory saving the state of step");
     s->n = p->n;
@@ -68,7 +72,8 @@ static int save_state(saved_state *s, const mf_particles *p, double time)
     memcpy(s->kind, p->kind, p->n);
     memcpy(s->id, p->id, p->n * sizeof(int64_t));
     for (int f = 0; f < p->nfields; f++)
-        memcpy(s->field[f], p->field[f].data, field_bytes(&p->field[f], p->n));
+        if (s->field[f])
+            memcpy(s->field[f], p->field[f].data, field_bytes(&p->field[f], p->n));
     return 0;
 }
 

@@ -1,7 +1,7 @@
 /* hdf5_writer.c: write one snapshot file (layout in mf_hdf5.h).
  *
  * On one rank the file is built in memory, written as "<path>.tmp" (by us,
- * not HDF5: build_image), synced and renamed: the real name only ever holds a
+ * not HDF5: write_in_memory), synced and renamed: the real name only ever holds a
  * complete file, and a write that fails (a full disk) leaves no HDF5 handle
  * open. Particles are grouped by kind in storage order; StorageIndex
  * records where each came from.
@@ -366,22 +366,112 @@ static int write_contents(snap_writer *w, const mf_sim *sim, const mf_dict *para
     return 0;
 }
 
+/* The core driver's memory, allocated through HDF5's file image callbacks
+ * (H5Pset_file_image_callbacks) so that we know where it is: the finished
+ * image is written to the disk from there, not from a copy of it. */
+typedef struct image_store {
+    unsigned char *mem; /* the driver's buffer, NULL until its first write */
+    size_t size;        /* its allocated bytes (a multiple of the increment) */
+} image_store;
+
+static void *image_malloc(size_t size, H5FD_file_image_op_t op, void *udata)
+{
+    (void)op;
+    image_store *store = udata;
+    void *mem = malloc(size);
+    if (mem) {
+        store->mem = mem;
+        store->size = size;
+    }
+    return mem;
+}
+
+/* Called only for an image given at open (H5Pset_file_image): none here. */
+static void *image_memcpy(void *dest, const void *src, size_t size, H5FD_file_image_op_t op,
+                          void *udata)
+{
+    (void)op;
+    (void)udata;
+    return memcpy(dest, src, size);
+}
+
+static void *image_realloc(void *ptr, size_t size, H5FD_file_image_op_t op, void *udata)
+{
+    (void)op;
+    image_store *store = udata;
+    void *mem = realloc(ptr, size);
+    if (mem) {
+        store->mem = mem;
+        store->size = size;
+    }
+    return mem;
+}
+
+static herr_t image_free(void *ptr, H5FD_file_image_op_t op, void *udata)
+{
+    (void)op;
+    image_store *store = udata;
+    if (ptr == store->mem) {
+        store->mem = NULL;
+        store->size = 0;
+    }
+    free(ptr);
+    return 0;
+}
+
+/* The fapl is copied into the file: the copy points at the same store. */
+static void *image_udata_copy(void *udata) { return udata; }
+static herr_t image_udata_free(void *udata)
+{
+    (void)udata;
+    return 0;
+}
+
+/* Bytes of the file as written: a run of the driver's buffer, or zeros. */
+typedef struct image_piece {
+    const unsigned char *bytes;
+    size_t size;
+} image_piece;
+
+static int write_image(const char *tmp, const image_piece *piece, int npieces);
+
+/* The superblock's file consistency flags (HDF5 file format specification,
+ * superblock versions 0 and 1: 4 bytes at offset 20, after the signature,
+ * the versions, the sizes and the two group K values). An open file has
+ * its write-access bit set there; H5Fget_file_image clears the flags in the
+ * image it returns, as a file is left on close. Versions 2 and 3 (which
+ * mf_h5_fapl never asks for: the library's default, the earliest format)
+ * keep one byte at offset 11 under the superblock's checksum. */
+#define SUPERBLOCK_VERSION_AT 8
+#define SUPERBLOCK_V01_FLAGS_AT 20
+#define SUPERBLOCK_V01_FLAGS_SIZE 4
+
 /* One rank: the snapshot is built in memory (HDF5's core driver, no
- * backing store) and written to the file by us in one go: HDF5 itself never
- * writes to the disk, so a full disk (or any write error) is a failed
- * write() of ours, reported with its errno, after which nothing of HDF5 is
- * left open. With HDF5 writing the file itself, a failure while it flushed
- * left the file open inside the library, and closing it at exit crashed.
- * The cost is the file's image in memory while it is written (twice:
- * HDF5's and the copy). */
-static int build_image(snap_writer *w, const mf_sim *sim, const mf_dict *params,
-                       const int64_t counts[MF_NKINDS], void **image, size_t *size)
+ * backing store) and written to tmp by us in one go, from the driver's own
+ * buffer, before the file is closed: HDF5 itself never writes to the disk,
+ * so a full disk (or any write error) is a failed write() of ours, reported
+ * with its errno, after which nothing of HDF5 is left open. With HDF5
+ * writing the file itself, a failure while it flushed left the file open
+ * inside the library, and closing it at exit crashed. The cost is the
+ * file's image in memory while it is built and written, once: taking it
+ * with H5Fget_file_image would copy it whole (8.8 MB on the 3-D bench case,
+ * which set the run's peak). The bytes written are those H5Fget_file_image
+ * returns after the flush: the first eoa bytes of the driver's buffer with
+ * the superblock's consistency flags cleared (test_hdf5 checks the two
+ * against each other). */
+static int write_in_memory(snap_writer *w, const char *tmp, const mf_sim *sim,
+                           const mf_dict *params, const int64_t counts[MF_NKINDS])
 {
     char detail[256];
-    *image = NULL;
-    *size = 0;
+    image_store store = {0};
+    H5FD_file_image_callbacks_t callbacks = {
+        .image_malloc = image_malloc,         .image_memcpy = image_memcpy,
+        .image_realloc = image_realloc,       .image_free = image_free,
+        .udata_copy = image_udata_copy,       .udata_free = image_udata_free,
+        .udata = &store};
     hid_t fapl = mf_h5_fapl();
-    if (fapl >= 0 && H5Pset_fapl_core(fapl, (size_t)1 << 20, 0) < 0)
+    if (fapl >= 0 && (H5Pset_fapl_core(fapl, (size_t)1 << 20, 0) < 0 ||
+                      H5Pset_file_image_callbacks(fapl, &callbacks) < 0))
         mf_h5_close(&fapl);
     w->file = fapl < 0 ? H5I_INVALID_HID : H5Fcreate(w->path, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
     /* Take the message before any other HDF5 call clears the error stack. */
@@ -391,17 +481,28 @@ static int build_image(snap_writer *w, const mf_sim *sim, const mf_dict *params,
         return MF_ERROR(MF_ERR_IO, "cannot create %s in memory (%s)", w->path, detail);
     int rc = 0;
     MF_CALL_GOTO(rc, write_contents(w, sim, params, counts), done);
-    /* Flushed first: the image must hold the metadata still in HDF5's caches. */
+    /* Flushed first: the image must hold the metadata still in HDF5's
+     * caches. With no buffer H5Fget_file_image only says the image's size
+     * (its end of allocation), all of it written, so inside the buffer. */
     ssize_t n = H5Fflush(w->file, H5F_SCOPE_GLOBAL) < 0 ? -1 : H5Fget_file_image(w->file, NULL, 0);
-    if (n > 0 && (*image = malloc((size_t)n)) != NULL && H5Fget_file_image(w->file, *image, (size_t)n) == n) {
-        *size = (size_t)n;
-    } else {
-        rc = n > 0 && !*image ? MF_ERROR(MF_ERR_MEMORY, "%s: out of memory for its %zd bytes", w->path, n)
-                              : MF_ERROR(MF_ERR_IO, "cannot finish %s in memory (%s)", w->path,
-                                         mf_h5_error_detail(detail, sizeof detail));
-        free(*image);
-        *image = NULL;
+    if (n <= 0 || !store.mem || (size_t)n > store.size) {
+        rc = MF_ERROR(MF_ERR_IO, "cannot finish %s in memory (%s)", w->path,
+                      n <= 0 ? mf_h5_error_detail(detail, sizeof detail)
+                             : "its end lies past the driver's buffer");
+        goto done;
     }
+    unsigned version = store.mem[SUPERBLOCK_VERSION_AT];
+    if (version > 1 || (size_t)n < SUPERBLOCK_V01_FLAGS_AT + SUPERBLOCK_V01_FLAGS_SIZE) {
+        rc = MF_ERROR(MF_ERR_INTERNAL, "%s: superblock version %u (%zd bytes): this writer "
+                      "clears the flags of versions 0 and 1 only", w->path, version, n);
+        goto done;
+    }
+    static const unsigned char cleared[SUPERBLOCK_V01_FLAGS_SIZE] = {0};
+    const size_t after = SUPERBLOCK_V01_FLAGS_AT + SUPERBLOCK_V01_FLAGS_SIZE;
+    const image_piece piece[] = {{store.mem, SUPERBLOCK_V01_FLAGS_AT},
+                                 {cleared, SUPERBLOCK_V01_FLAGS_SIZE},
+                                 {store.mem + after, (size_t)n - after}};
+    rc = write_image(tmp, piece, 3);
 done:
     close_all(&w->file);
     return rc;
@@ -435,22 +536,30 @@ static int write_collective(snap_writer *w, const char *tmp, const mf_sim *sim,
     return 0;
 }
 
-/* size bytes to tmp, synced: a short write or a failed sync removes tmp. */
-static int write_image(const char *tmp, const void *image, size_t size)
+/* The pieces of the file, in order, to tmp, synced: a short write or a
+ * failed sync removes tmp. */
+static int write_image(const char *tmp, const image_piece *piece, int npieces)
 {
+    size_t size = 0;
+    for (int k = 0; k < npieces; k++)
+        size += piece[k].size;
     int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
     if (fd < 0)
         return MF_ERROR(MF_ERR_IO, "cannot create %s (%s, errno %d)", tmp, strerror(errno), errno);
     size_t done = 0;
     int err = 0;
-    while (done < size && !err) {
-        ssize_t put = write(fd, (const char *)image + done, size - done);
-        if (put < 0 && errno == EINTR)
-            continue;
-        if (put <= 0)
-            err = put < 0 ? errno : ENOSPC;
-        else
-            done += (size_t)put;
+    for (int k = 0; k < npieces && !err; k++) {
+        size_t put_of = 0;
+        while (put_of < piece[k].size && !err) {
+            ssize_t put = write(fd, piece[k].bytes + put_of, piece[k].size - put_of);
+            if (put < 0 && errno == EINTR)
+                continue;
+            if (put <= 0)
+                err = put < 0 ? errno : ENOSPC;
+            else
+                put_of += (size_t)put;
+        }
+        done += put_of;
     }
     if (!err && fsync(fd) != 0 && errno != EINVAL)
         err = errno;
@@ -502,16 +611,11 @@ int mf_hdf5_write_snapshot(const char *path, const mf_sim *sim, const mf_dict *p
 
     mf_h5_quiet quiet;
     mf_h5_quiet_begin(&quiet);
-    void *image = NULL;
-    size_t size = 0;
     rc = sim->par ? write_collective(&w, tmp, sim, params, counts)
-                  : build_image(&w, sim, params, counts, &image, &size);
+                  : write_in_memory(&w, tmp, sim, params, counts);
     mf_h5_quiet_end(&quiet);
     free(w.index);
     free(w.buf);
-    if (rc == 0 && !sim->par)
-        rc = write_image(tmp, image, size);
-    free(image);
     /* Every rank has closed the file (a collective close) before rank 0
      * renames it. */
     rc = mf_parallel_agree(sim->par, rc);

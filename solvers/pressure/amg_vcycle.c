@@ -26,6 +26,25 @@ extern void dgetrs_(const char *trans, const int *n, const int *nrhs, const doub
 
 /* ---- the split matrix -------------------------------------------------- */
 
+/* Columns and values with room for need + 1 entries: grown when *cap is
+ * below need or nothing is there yet (*cap then need). False when out of
+ * memory (what was there stays, *cap unchanged). */
+static bool grow_entries(int32_t **col, double **val, size_t *cap, size_t need)
+{
+    if (need <= *cap && *col != NULL)
+        return true;
+    int32_t *c = realloc(*col, (need + 1) * sizeof *c);
+    if (c)
+        *col = c;
+    double *v = realloc(*val, (need + 1) * sizeof *v);
+    if (v)
+        *val = v;
+    if (!c || !v)
+        return false;
+    *cap = need;
+    return true;
+}
+
 static int split_reserve(mf_split_csr *s, size_t n, size_t nnz)
 {
     if (n > s->cap_rows) {
@@ -45,17 +64,8 @@ static int split_reserve(mf_split_csr *s, size_t n, size_t nnz)
             return MF_ERROR(MF_ERR_MEMORY, "out of memory for a matrix of %zu rows", n);
         s->cap_rows = n;
     }
-    if (nnz > s->cap_nnz || s->col_buf == NULL) {
-        int32_t *col = realloc(s->col_buf, (nnz + 1) * sizeof *col);
-        if (col)
-            s->col_buf = col;
-        double *val = realloc(s->val_buf, (nnz + 1) * sizeof *val);
-        if (val)
-            s->val_buf = val;
-        if (!col || !val)
-            return MF_ERROR(MF_ERR_MEMORY, "out of memory for a matrix of %zu non-zeros", nnz);
-        s->cap_nnz = nnz;
-    }
+    if (!grow_entries(&s->col_buf, &s->val_buf, &s->cap_nnz, nnz))
+        return MF_ERROR(MF_ERR_MEMORY, "out of memory for a matrix of %zu non-zeros", nnz);
     return 0;
 }
 
@@ -120,19 +130,151 @@ static int64_t split_row_mid(const int32_t *col, size_t begin, size_t end, int32
     return e == end ? (int64_t)mid : -1;
 }
 
+/* Room for the in-place split's bits and one row. */
+static int split_reserve_lent(mf_split_csr *s, size_t nnz, size_t longest)
+{
+    const size_t words = nnz / 64 + 2;
+    if (words > s->cap_upper) {
+        uint64_t *u = realloc(s->upper, words * sizeof *u);
+        if (u == NULL)
+            return MF_ERROR(MF_ERR_MEMORY, "out of memory splitting %zu non-zeros", nnz);
+        s->upper = u;
+        s->cap_upper = words;
+    }
+    if (!grow_entries(&s->row_buf, &s->row_val, &s->cap_row, longest + 1))
+        return MF_ERROR(MF_ERR_MEMORY, "out of memory for a row of %zu entries", longest);
+    return 0;
+}
+
+/* Bit k of the upper marks (set: entry k, counted from the matrix's first,
+ * is above the diagonal). */
+static inline bool is_upper(const uint64_t *upper, size_t k)
+{
+    return (upper[k / 64] >> (k % 64)) & 1;
+}
+
+/* Row i's off-diagonal entries [b, e) of A (relative to col, val): lower
+ * ones first, then upper ones, each in their order, the marks set. Returns
+ * where the upper ones start; *twice set when the diagonal was among them. */
+static int64_t split_row_in_place(mf_split_csr *s, int32_t *col, double *val, size_t b,
+                                  size_t e, int32_t i, bool *twice)
+{
+    size_t w = b, nu = 0;
+    for (size_t k = b; k < e; k++) {
+        const int32_t c = col[k];
+        *twice |= c == i;
+        if (c < i) {
+            s->upper[k / 64] &= ~(UINT64_C(1) << (k % 64));
+            col[w] = c;
+            val[w++] = val[k];
+        } else {
+            s->upper[k / 64] |= UINT64_C(1) << (k % 64);
+            s->row_buf[nu] = c;
+            s->row_val[nu++] = val[k];
+        }
+    }
+    memcpy(col + w, s->row_buf, nu * sizeof *col);
+    memcpy(val + w, s->row_val, nu * sizeof *val);
+    return (int64_t)w;
+}
+
+/* split_row_in_place's inverse. */
+static void merge_row_in_place(mf_split_csr *s, int32_t *col, double *val, size_t b, size_t mid,
+                               size_t e)
+{
+    /* The upper ones aside, then lower ones moved back to their places from
+     * the end (a lower entry only moves right), the upper ones between. */
+    const size_t nu = e - mid;
+    memcpy(s->row_buf, col + mid, nu * sizeof *col);
+    memcpy(s->row_val, val + mid, nu * sizeof *val);
+    size_t lo = mid, up = nu;
+    for (size_t k = e; k-- > b;) {
+        if (is_upper(s->upper, k)) {
+            up--;
+            col[k] = s->row_buf[up];
+            val[k] = s->row_val[up];
+        } else {
+            lo--;
+            col[k] = col[lo];
+            val[k] = val[lo];
+        }
+    }
+}
+
+void mf_split_csr_restore(mf_split_csr *s)
+{
+    const mf_csr *A = s->lent;
+    if (A == NULL)
+        return;
+    const size_t *rp = A->rowptr;
+    const size_t k0 = rp[0];
+    for (size_t i = 0; i < A->nrows; i++)
+        merge_row_in_place(s, A->col + k0, A->val + k0, rp[i] + 1 - k0, (size_t)s->mid[i],
+                           rp[i + 1] - k0);
+    s->lent = NULL;
+}
+
+/* Split A's rows in its lent arrays; false (A as it was) when a row does
+ * not lead with its diagonal or holds it twice. */
+static bool split_lent(mf_split_csr *s, const mf_csr *A)
+{
+    const size_t *rp = A->rowptr;
+    const size_t k0 = rp[0];
+    int32_t *col = A->col + k0;
+    double *val = A->val + k0;
+    for (size_t i = 0; i < A->nrows; i++) {
+        const size_t b = rp[i] - k0, e = rp[i + 1] - k0;
+        bool twice = false;
+        int64_t mid = b < e && col[b] == (int32_t)i
+                          ? split_row_in_place(s, col, val, b + 1, e, (int32_t)i, &twice)
+                          : -1;
+        if (twice) { /* a second diagonal entry: this row back first */
+            s->mid[i] = (int32_t)mid;
+            merge_row_in_place(s, col, val, b + 1, (size_t)mid, e);
+            mid = -1;
+        }
+        if (mid < 0) {
+            for (size_t r = 0; r < i; r++)
+                merge_row_in_place(s, col, val, rp[r] + 1 - k0, (size_t)s->mid[r],
+                                   rp[r + 1] - k0);
+            return false;
+        }
+        s->mid[i] = (int32_t)mid;
+    }
+    return true;
+}
+
 int mf_split_csr_fine(mf_split_csr *s, const mf_csr *A)
 {
     const size_t n = A->nrows;
     const size_t nnz = n > 0 ? A->rowptr[n] - A->rowptr[0] : 0;
+    s->lent = NULL;
     if (n == 0 || n > INT32_MAX || nnz >= INT32_MAX)
         return mf_split_csr_set(s, A);
     const size_t *rp = A->rowptr;
     const size_t k0 = rp[0];
-    /* Look first: a row that is not in the view's order makes it a copy. */
-    for (size_t i = 0; i < n; i++)
-        if (split_row_mid(A->col, rp[i], rp[i + 1], (int32_t)i) < 0)
-            return mf_split_csr_set(s, A);
-    MF_CALL(split_reserve(s, n, 0));
+    /* Split in the lent arrays; else a view when the rows are already
+     * split, or a copy. */
+    bool lent = false;
+    if (A->lent_capacity > 0) {
+        size_t longest = 0;
+        for (size_t i = 0; i < n; i++)
+            if (rp[i + 1] - rp[i] > longest)
+                longest = rp[i + 1] - rp[i];
+        MF_CALL(split_reserve_lent(s, nnz, longest));
+        MF_CALL(split_reserve(s, n, 0));
+        lent = split_lent(s, A);
+    }
+    if (!lent) {
+        for (size_t i = 0; i < n; i++)
+            if (split_row_mid(A->col, rp[i], rp[i + 1], (int32_t)i) < 0)
+                return mf_split_csr_set(s, A);
+        MF_CALL(split_reserve(s, n, 0));
+        for (size_t i = 0; i < n; i++)
+            s->mid[i] = (int32_t)(split_row_mid(A->col, rp[i], rp[i + 1], (int32_t)i) -
+                                  (int64_t)k0);
+    }
+    s->lent = lent ? A : NULL;
     s->col = A->col + k0;
     s->val = A->val + k0;
     s->gap = 1;
@@ -140,7 +282,6 @@ int mf_split_csr_fine(mf_split_csr *s, const mf_csr *A)
         /* the copy's diagonal: 0 + the one entry (the same bits but for a -0) */
         const double d = 0.0 + A->val[rp[i]];
         s->ptr[i] = (int32_t)(rp[i] - k0 + 1);
-        s->mid[i] = (int32_t)(split_row_mid(A->col, rp[i], rp[i + 1], (int32_t)i) - (int64_t)k0);
         s->diag[i] = d;
         s->dinv[i] = d != 0.0 ? 1.0 / d : 0.0;
     }
@@ -151,6 +292,10 @@ int mf_split_csr_fine(mf_split_csr *s, const mf_csr *A)
 
 void mf_split_csr_free(mf_split_csr *s)
 {
+    mf_split_csr_restore(s);
+    free(s->upper);
+    free(s->row_buf);
+    free(s->row_val);
     free(s->ptr);
     free(s->mid);
     free(s->col_buf);
@@ -278,7 +423,8 @@ static int copy_matrix(mf_split_csr *s, hypre_ParCSRMatrix *A)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory copying a level of %d rows", n);
     for (HYPRE_Int i = 0; i <= n; i++)
         rp[i] = (size_t)I[i];
-    const mf_csr c = {(size_t)n, 0, n, rp, hypre_CSRMatrixJ(D), hypre_CSRMatrixData(D), 0};
+    const mf_csr c = {.nrows = (size_t)n, .nglobal = n, .rowptr = rp,
+                      .col = hypre_CSRMatrixJ(D), .val = hypre_CSRMatrixData(D)};
     int rc = mf_split_csr_set(s, &c);
     free(rp);
     return rc;
@@ -487,12 +633,15 @@ static int pcg_run(mf_amg_vcycle *v, const mf_csr *A_in, const int64_t *prow, do
             rr += r[i] * r[i];
         }
         if (rr <= stop2) {
-            /* Tentatively converged: decide on the true residual. */
+            /* Tentatively converged: decide on the true residual (from
+             * the caller's rows, in their order). */
+            mf_split_csr_restore(&v->fine);
             const double t = resid(ctx, x, r);
             if (t <= stop) {
                 *rel = t / bnorm;
                 return 0;
             }
+            MF_CALL(mf_split_csr_fine(&v->fine, A_in));
         }
         mf_amg_vcycle_apply(v, A, prow, r, z);
         double g = 0.0;
@@ -503,6 +652,7 @@ static int pcg_run(mf_amg_vcycle *v, const mf_csr *A_in, const int64_t *prow, do
         for (size_t i = 0; i < n; i++)
             p[i] = z[i] + beta * p[i];
     }
+    mf_split_csr_restore(&v->fine);
     *rel = resid(ctx, x, r) / bnorm;
     return MF_RETRY;
 }
@@ -513,7 +663,8 @@ int mf_amg_pcg(mf_amg_vcycle *v, const mf_csr *A, const int64_t *prow, double *x
 {
     int rc = pcg_run(v, A, prow, x, r, bnorm, tol, max_iter, resid, ctx, iterations, rel);
     /* The fine level's copy goes with the solve: kept, it would sit beside
-     * the next step's matrix while that is assembled (peak memory). */
+     * the next step's matrix while that is assembled (peak memory). A split
+     * in the caller's arrays is undone first (mf_split_csr_free). */
     mf_split_csr_free(&v->fine);
     return rc;
 }

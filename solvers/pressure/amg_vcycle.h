@@ -53,6 +53,15 @@ typedef struct mf_split_csr {
     int32_t *col_buf;    /* a copy's own entries (col and val point here) */
     double *val_buf;
     size_t cap_rows, cap_nnz;
+    /* Split in the lent arrays of a CSR (mf_csr.lent_capacity): bit k of
+     * upper (one per off-diagonal entry, in the CSR's order) says whether
+     * it lies above the diagonal, which is all mf_split_csr_restore needs
+     * to put the rows back in their order. */
+    const mf_csr *lent;
+    uint64_t *upper;
+    int32_t *row_buf;
+    double *row_val;
+    size_t cap_upper, cap_row;
 } mf_split_csr;
 
 /* End of row i's off-diagonal entries. */
@@ -65,12 +74,18 @@ static inline int32_t mf_split_end(const mf_split_csr *s, int32_t i)
  * anywhere in its row, duplicates summed into it) into the split layout,
  * growing s's arrays as needed. */
 int mf_split_csr_set(mf_split_csr *s, const mf_csr *A);
-/* The same layout without the copy when every row of A is its diagonal
- * (once) followed by its lower entries, then its upper ones (the MPS
- * pressure equation: neighbours in index order): s then reads A's col and
- * val, which must outlive it; otherwise a copy (mf_split_csr_set). The
- * values and their order are the copy's either way. */
+/* The same layout without a copy when every row of A starts with its
+ * diagonal (and has it once): when the rows are already split (lower
+ * columns, then upper ones) s reads A's col and val; when A lends them
+ * (mf_csr.lent_capacity, the MPS pressure matrix) each row is split in
+ * them, to be put back by mf_split_csr_restore. Otherwise a copy
+ * (mf_split_csr_set). The values and their order are the copy's either
+ * way; A must outlive s. */
 int mf_split_csr_fine(mf_split_csr *s, const mf_csr *A);
+/* A split in place (mf_split_csr_fine) back to A's own order, bit for bit;
+ * nothing for a copy or a view. s is then no longer good for a cycle until
+ * split again. */
+void mf_split_csr_restore(mf_split_csr *s);
 void mf_split_csr_free(mf_split_csr *s);
 
 /* q = A p; returns p . q. */
