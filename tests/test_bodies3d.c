@@ -36,6 +36,8 @@
 #include "body_cases.h"
 #include "case_util.h"
 #include "mf_test.h"
+#include "mf_trimesh.h"
+#include "mf_walls.h"
 
 #define MOMENTUM_TOL 1e-8 /* of P(0): the CSV's 9 significant digits */
 
@@ -277,6 +279,149 @@ static void check_cylinder_momentum(const char *exe)
     tc_case_destroy(&c);
 }
 
+/* A box [lo, hi] as 12 outward-wound triangles, each vertex turned by R
+ * about c (R NULL: not turned). */
+static void box_mesh(mf_trimesh *m, const double lo[3], const double hi[3], const double R[9],
+                     const double c[3])
+{
+    mf_trimesh_init(m);
+    for (int k = 0; k < 8; k++) {
+        const double x[3] = {k & 1 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1], k & 4 ? hi[2] : lo[2]};
+        double y[3];
+        for (int i = 0; i < 3; i++) {
+            y[i] = c[i];
+            for (int j = 0; j < 3; j++)
+                y[i] += (R ? R[3 * i + j] : i == j) * (x[j] - c[j]);
+        }
+        CHECK_OK(mf_trimesh_add_vertex(m, y));
+    }
+    static const int32_t tris[12][3] = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6},
+                                        {0, 1, 4}, {1, 5, 4}, {2, 6, 3}, {3, 6, 7},
+                                        {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+    for (int t = 0; t < 12; t++)
+        CHECK_OK(mf_trimesh_add_triangle(m, tris[t][0], tris[t][1], tris[t][2]));
+}
+
+/* mf_trimesh_mass (Eberly 2002) against the exact solids: a box far from
+ * the origin, the same box turned (the tensor R D R^T: the off-diagonal
+ * terms and their signs), the box wound inward (the volume's sign), and an
+ * icosphere, which lies between the balls through its vertices (radius r)
+ * and tangent to its faces (r_in): its volume and its moments of inertia
+ * V <I_xx> lie between the two balls' (the integral of y^2 + z^2 grows
+ * with the region), its centroid at the centre. */
+static void check_mesh_mass(void)
+{
+    const double lo[3] = {10, -5, 3}, e[3] = {0.1, 0.2, 0.3};
+    const double hi[3] = {lo[0] + e[0], lo[1] + e[1], lo[2] + e[2]};
+    const double c[3] = {lo[0] + 0.05, lo[1] + 0.1, lo[2] + 0.15};
+    const double D[3] = {(e[1] * e[1] + e[2] * e[2]) / 12, (e[0] * e[0] + e[2] * e[2]) / 12,
+                         (e[0] * e[0] + e[1] * e[1]) / 12};
+    double R[9];
+    const double axis[3] = {1 / sqrt(3.0), 1 / sqrt(3.0), 1 / sqrt(3.0)};
+    mf_rotation_matrix(axis, 0.7, R);
+    for (int turned = 0; turned < 2; turned++) {
+        mf_trimesh m;
+        box_mesh(&m, lo, hi, turned ? R : NULL, c);
+        double V, x[3], I[9], worst = 0;
+        mf_trimesh_mass(&m, &V, x, I);
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++) {
+                double want = 0;
+                for (int k = 0; k < 3; k++)
+                    want += (turned ? R[3 * i + k] * R[3 * j + k] : (i == k) * (j == k)) * D[k];
+                worst = fmax(worst, fabs(I[3 * i + j] - want) / D[0]);
+            }
+        for (int a = 0; a < 3; a++)
+            worst = fmax(worst, fabs(x[a] - c[a]) / e[0]);
+        printf("mesh mass: box%s: volume %.15g (exact %.15g), worst relative difference of the "
+               "centre and inertia %.3g\n", turned ? " turned" : "", V, e[0] * e[1] * e[2], worst);
+        CHECK(fabs(V / (e[0] * e[1] * e[2]) - 1) < 1e-12);
+        CHECK(worst < 1e-12);
+        if (!turned) { /* wound inward: every triangle turned */
+            for (size_t t = 0; t < m.ntris; t++) {
+                const int32_t k = m.tri[3 * t + 1];
+                m.tri[3 * t + 1] = m.tri[3 * t + 2];
+                m.tri[3 * t + 2] = k;
+            }
+            mf_trimesh_mass(&m, &V, x, I);
+            CHECK(fabs(V / (e[0] * e[1] * e[2]) + 1) < 1e-12);
+        }
+        mf_trimesh_free(&m);
+    }
+    /* the icosphere: an icosahedron subdivided 3 times, on radius r */
+    const double r = 0.05, gr = (1 + sqrt(5.0)) / 2;
+    mf_trimesh m;
+    mf_trimesh_init(&m);
+    const double v12[12][3] = {{-1, gr, 0}, {1, gr, 0}, {-1, -gr, 0}, {1, -gr, 0},
+                               {0, -1, gr}, {0, 1, gr}, {0, -1, -gr}, {0, 1, -gr},
+                               {gr, 0, -1}, {gr, 0, 1}, {-gr, 0, -1}, {-gr, 0, 1}};
+    static const int32_t f20[20][3] = {
+        {0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+        {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+        {3, 8, 9},  {4, 9, 5},  {2, 4, 11},  {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+    double *tri = malloc(9 * 20 * sizeof *tri);
+    size_t nt = 20;
+    for (size_t t = 0; t < nt; t++)
+        for (int k = 0; k < 3; k++)
+            for (int a = 0; a < 3; a++)
+                tri[9 * t + 3 * k + a] = v12[f20[t][k]][a];
+    for (int level = 0; level < 3; level++) { /* each triangle into 4, on the sphere */
+        double *next = malloc(4 * 9 * nt * sizeof *next);
+        for (size_t t = 0; t < nt; t++) {
+            double p[6][3];
+            for (int k = 0; k < 3; k++)
+                for (int a = 0; a < 3; a++) {
+                    p[k][a] = tri[9 * t + 3 * k + a];
+                    p[3 + k][a] = 0.5 * (tri[9 * t + 3 * k + a] + tri[9 * t + 3 * ((k + 1) % 3) + a]);
+                }
+            static const int sub[4][3] = {{0, 3, 5}, {3, 1, 4}, {5, 4, 2}, {3, 4, 5}};
+            for (int s4 = 0; s4 < 4; s4++)
+                for (int k = 0; k < 3; k++)
+                    memcpy(&next[9 * (4 * t + s4) + 3 * k], p[sub[s4][k]], 3 * sizeof(double));
+        }
+        free(tri);
+        tri = next;
+        nt *= 4;
+    }
+    double r_in = r;
+    for (size_t t = 0; t < nt; t++) {
+        int32_t id[3];
+        double q[3][3];
+        for (int k = 0; k < 3; k++) {
+            const double *y = &tri[9 * t + 3 * k];
+            const double len = sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2]);
+            for (int a = 0; a < 3; a++)
+                q[k][a] = r * y[a] / len;
+            id[k] = (int32_t)m.nverts;
+            CHECK_OK(mf_trimesh_add_vertex(&m, q[k]));
+        }
+        CHECK_OK(mf_trimesh_add_triangle(&m, id[0], id[1], id[2]));
+        const double e1[3] = {q[1][0] - q[0][0], q[1][1] - q[0][1], q[1][2] - q[0][2]};
+        const double e2[3] = {q[2][0] - q[0][0], q[2][1] - q[0][1], q[2][2] - q[0][2]};
+        const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                             e1[0] * e2[1] - e1[1] * e2[0]};
+        const double nl = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        r_in = fmin(r_in, fabs(n[0] * q[0][0] + n[1] * q[0][1] + n[2] * q[0][2]) / nl);
+    }
+    free(tri);
+    double V, x[3], I[9];
+    mf_trimesh_mass(&m, &V, x, I);
+    const double ball = 4.0 / 3.0 * M_PI;
+    const double V_in = ball * pow(r_in, 3), V_out = ball * pow(r, 3);
+    const double I_in = 0.4 * r_in * r_in * V_in, I_out = 0.4 * r * r * V_out;
+    printf("mesh mass: icosphere of %zu triangles, r = %g, faces at r_in = %.6g: volume %.6g in "
+           "(%.6g, %.6g), V I_xx %.6g, V I_yy %.6g, V I_zz %.6g in (%.6g, %.6g), centre (%.2g "
+           "%.2g %.2g), I_xy %.2g\n", m.ntris, r, r_in, V, V_in, V_out, V * I[0], V * I[4],
+           V * I[8], I_in, I_out, x[0], x[1], x[2], I[1]);
+    CHECK(V > V_in && V < V_out);
+    for (int a = 0; a < 3; a++) {
+        CHECK(V * I[4 * a] > I_in && V * I[4 * a] < I_out);
+        CHECK(fabs(x[a]) < 1e-12 * r);
+    }
+    CHECK(fabs(I[1]) < 1e-12 * r * r && fabs(I[2]) < 1e-12 * r * r && fabs(I[5]) < 1e-12 * r * r);
+    mf_trimesh_free(&m);
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -284,6 +429,8 @@ int main(int argc, char **argv)
         return 2;
     }
     const char *only = argc > 2 ? argv[2] : ""; /* a part's name: that part alone */
+    if (!*only || strcmp(only, "mass") == 0)
+        check_mesh_mass();
     if (!*only || strcmp(only, "momentum") == 0)
         check_cylinder_momentum(argv[1]);
     if (!*only || strcmp(only, "float") == 0)

@@ -15,6 +15,7 @@
 #include "mf_fs.h"
 #include "mf_parallel.h"
 #include "bodies_internal.h"
+#include "walls_internal.h"
 
 
 /* Inverse of a symmetric positive definite 3x3 matrix (the adjugate). */
@@ -35,6 +36,29 @@ static bool invert3(const double A[9], double B[9])
     B[7] = (A[1] * A[6] - A[0] * A[7]) / det;
     B[8] = (A[0] * A[4] - A[1] * A[3]) / det;
     return true;
+}
+
+/* A closed mesh's volume, centroid and inertia per unit mass
+ * (mf_trimesh_mass: Eberly 2002, Mirtich 1996); an open or inside-out
+ * surface is refused. */
+static int mesh_inertia(const mf_wall *w, double *volume, double centre[3], double I[9])
+{
+    const mf_trimesh *m = mf_wall_mesh_surface(w->mesh);
+    mf_trimesh_report r;
+    MF_CALL(mf_wall_mesh_report(w->mesh, &r));
+    mf_trimesh_mass(m, volume, centre, I);
+    if (!r.closed)
+        return MF_ERROR(MF_ERR_INPUT, "%s: obstacle '%s', file '%s': not a closed surface (%zu "
+                        "open edges, the first at (%g %g %g); %zu edges of three or more "
+                        "triangles; signed volume %g m^3): the mass of a rigid body from its "
+                        "density needs a closed mesh (or give mass, inertia and origin)",
+                        w->where, w->name, m->name, r.nboundary, r.at_boundary[0],
+                        r.at_boundary[1], r.at_boundary[2], r.nnonmanifold, *volume);
+    if (!(*volume > 0))
+        return MF_ERROR(MF_ERR_INPUT, "%s: obstacle '%s', file '%s': the surface is inside out "
+                        "(signed volume %g m^3: its triangles' normals (b - a) x (c - a) point "
+                        "inward): turn its triangles", w->where, w->name, m->name, *volume);
+    return 0;
 }
 
 /* Volume (2-D: area), the centre and the inertia per unit mass of a shape. */
@@ -86,9 +110,14 @@ static int shape_inertia(const mf_wall *w, int dim, double *volume, double centr
                                along * w->axis[i] * w->axis[j];
         return 0;
     }
-    return MF_ERROR(MF_ERR_INPUT, "%s: obstacle '%s': a rigid mesh body needs its mass, inertia "
-                    "and origin (the centre of mass) in motion { type rigid; mass ...; inertia "
-                    "(...); origin (...); } (density works for box, cylinder and sphere)",
+    if (w->shape == MF_SOLID_MESH && dim == 3 && w->mesh)
+        return mesh_inertia(w, volume, centre, I);
+    /* 2-D: a mesh obstacle is a profile extruded across z = 0 (walls_mesh.c),
+     * whose section the triangles do not give */
+    return MF_ERROR(MF_ERR_INPUT, "%s: obstacle '%s': a rigid mesh body in 2-D needs its mass, "
+                    "inertia and origin (the centre of mass) in motion { type rigid; mass ...; "
+                    "inertia (...); origin (...); } (its section is not computed from the "
+                    "extruded profile; density works for box, cylinder, sphere and 3-D meshes)",
                     w->where, w->name);
 }
 
