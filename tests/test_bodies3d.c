@@ -192,38 +192,43 @@ static void check_cylinder_float(const char *exe)
     tc_case_destroy(&c);
 }
 
-static void check_cylinder_momentum(const char *exe)
+/* A blob 0.2 m across (x, y, z in 0.1..0.3) around a hole lo..hi holding
+ * the body `obstacle` (its entry in obstacles, named body, moving at U
+ * along x), in a closed tank 0.4 m across; obj: a polygon file written to
+ * constant/body.obj (NULL: none); mass: the body's, from its shape. */
+static void check_momentum(const char *exe, const char *what, const double lo[3],
+                           const double hi[3], const char *obstacle, const char *obj,
+                           double mass)
 {
     const double l0 = 0.02, U = 0.05;
     static const char *const ctl =
         "endTime 0.2;\ndeltaT 1e-4;\nadjustTimeStep yes;\nmaxCo 0.2;\nmaxDeltaT 1e-3;\n"
         "writeControl adjustableRunTime;\nwriteInterval 0.02;\n";
-    /* a blob 0.2 m across around a hole 0.06 x 0.06 x 0.04 m holding the
-     * cylinder (radius 0.03, length 0.04: caps half a spacing off the
-     * lattice's planes), in a closed tank 0.4 m across */
-    char geo[2048];
+    char geo[4096];
     snprintf(geo, sizeof geo,
              "dimension 3;\nparticleSpacing %g;\n"
              "fluidBlocks {\n"
-             " a { type box; min (0.1 0.1 0.1); max (0.17 0.3 0.3); fluid water; }\n"
-             " b { type box; min (0.23 0.1 0.1); max (0.3 0.3 0.3); fluid water; }\n"
-             " c { type box; min (0.17 0.1 0.1); max (0.23 0.17 0.3); fluid water; }\n"
-             " d { type box; min (0.17 0.23 0.1); max (0.23 0.3 0.3); fluid water; }\n"
-             " e { type box; min (0.17 0.17 0.1); max (0.23 0.23 0.18); fluid water; }\n"
-             " f { type box; min (0.17 0.17 0.22); max (0.23 0.23 0.3); fluid water; }\n}\n"
+             " a { type box; min (0.1 0.1 0.1); max (%g 0.3 0.3); fluid water; }\n"
+             " b { type box; min (%g 0.1 0.1); max (0.3 0.3 0.3); fluid water; }\n"
+             " c { type box; min (%g 0.1 0.1); max (%g %g 0.3); fluid water; }\n"
+             " d { type box; min (%g %g 0.1); max (%g 0.3 0.3); fluid water; }\n"
+             " e { type box; min (%g %g 0.1); max (%g %g %g); fluid water; }\n"
+             " f { type box; min (%g %g %g); max (%g %g 0.3); fluid water; }\n}\n"
              "walls { tank { type box; min (0 0 0); max (0.4 0.4 0.4); } }\n"
-             "obstacles { body { type cylinder; centre (0.2 0.2 0.2); radius 0.03;\n"
-             " axis (0 0 1); length 0.04;\n"
+             "obstacles { body { %s\n"
              " motion { type rigid; density 1000; g (0 0 0); velocity (%g 0 0); } } }\n",
-             l0, U);
+             l0, lo[0], hi[0], lo[0], hi[0], lo[1], lo[0], hi[1], hi[0], lo[0], lo[1], hi[0],
+             hi[1], lo[2], lo[0], lo[1], hi[2], hi[0], hi[1], obstacle, U);
     tc_case c;
     CHECK_OK(tc_case_from_strings(&c, exe, "bodies3d-momentum", ctl, TC_MOMENTUM_SOLVER,
                                   viscous, geo));
+    if (obj)
+        CHECK_OK(tc_case_write(&c, "constant/body.obj", obj));
     track tr = {0};
-    bool ok = run(&c, "cylinder momentum");
+    bool ok = run(&c, what);
     if (ok) {
         ok = read_track(c.dir, "body", &tr) == 0;
-        CHECK_MSG(ok, "cylinder momentum: no bodyState.csv rows");
+        CHECK_MSG(ok, "%s: no bodyState.csv rows", what);
     }
     if (ok) {
         tc_snapshots s;
@@ -258,25 +263,77 @@ static void check_cylinder_momentum(const char *exe)
             const double err = sqrt((P[0] - P0) * (P[0] - P0) + P[1] * P[1] + P[2] * P[2]);
             worst = fmax(worst, err);
             CHECK_MSG(err <= MOMENTUM_TOL * P0,
-                      "cylinder momentum: t = %g: |P - P(0)| = %g above %g P(0) (the impulse "
-                      "exchanged: %g)", h.time, err, MOMENTUM_TOL, impulse);
+                      "%s: t = %g: |P - P(0)| = %g above %g P(0) (the impulse "
+                      "exchanged: %g)", what, h.time, err, MOMENTUM_TOL, impulse);
             checked++;
         }
         tc_snapshots_free(&s);
         const double vl = tr.v[3 * (tr.n - 1)];
-        printf("cylinder momentum: mass %.6g kg, %zu snapshots, worst |P - P(0)| = %.3g P(0) "
+        printf("%s: mass %.6g kg, %zu snapshots, worst |P - P(0)| = %.3g P(0) "
                "(tolerance %.2g), the body at %.5f m/s of %g, impulse exchanged %.3g P(0)\n",
-               tr.mass, checked, worst / P0, MOMENTUM_TOL, vl, U, impulse / P0);
-        CHECK(fabs(tr.mass / (1000 * M_PI * 0.03 * 0.03 * 0.04) - 1) < 1e-8); /* 9 digits */
-        CHECK_MSG(checked >= 5, "cylinder momentum: only %zu snapshots matched", checked);
+               what, tr.mass, checked, worst / P0, MOMENTUM_TOL, vl, U, impulse / P0);
+        CHECK_MSG(fabs(tr.mass / mass - 1) < 1e-8, "%s: mass %.9g, its shape's %.9g", what, tr.mass,
+                  mass); /* 9 digits */
+        CHECK_MSG(checked >= 5, "%s: only %zu snapshots matched", what, checked);
         /* less than test_bodies' 2-D case (0.43 P(0)): the fluid beside the
          * voids the square hole leaves around the round body is free surface
          * (p = 0); still 1e6 times the tolerance */
         CHECK_MSG(vl < 0.99 * U && impulse > 0.01 * P0,
-                  "cylinder momentum: no exchange with the fluid (%g of %g m/s)", vl, U);
+                  "%s: no exchange with the fluid (%g of %g m/s)", what, vl, U);
         track_free(&tr);
     }
     tc_case_destroy(&c);
+}
+
+/* A cube 0.16..0.24 m, faces half a spacing (0.02 m) off the lattice's
+ * planes, outward-wound. */
+static const char *const cube_obj =
+    "v 0.16 0.16 0.16\nv 0.24 0.16 0.16\nv 0.16 0.24 0.16\nv 0.24 0.24 0.16\n"
+    "v 0.16 0.16 0.24\nv 0.24 0.16 0.24\nv 0.16 0.24 0.24\nv 0.24 0.24 0.24\n"
+    "f 1 3 2\nf 2 3 4\nf 5 6 7\nf 6 8 7\nf 1 2 5\nf 2 6 5\n"
+    "f 3 7 4\nf 4 7 8\nf 1 5 3\nf 3 5 7\nf 2 4 6\nf 4 8 6\n";
+
+/* A rigid mesh body from a density whose mesh is open (the cube without
+ * its last two triangles) or inside out (every triangle turned) is refused
+ * at setup, the message naming the entry (file:line), the file and the
+ * signed volume. */
+static void check_mesh_refused(const char *exe)
+{
+    char open_obj[1024], inward[1024];
+    snprintf(open_obj, sizeof open_obj, "%s", cube_obj);
+    *strstr(open_obj, "f 2 4 6") = '\0';
+    snprintf(inward, sizeof inward, "%s", cube_obj);
+    for (char *f = strstr(inward, "\nf "); f; f = strstr(f + 1, "\nf ")) {
+        char *b = strchr(f + 3, ' ') + 1, *c = strchr(b, ' ') + 1; /* swap b and c */
+        char tb = *b, tc = *c;
+        *b = tc;
+        *c = tb;
+    }
+    static const char *const ctl = "endTime 0.01;\ndeltaT 1e-4;\nwriteInterval 0.01;\n";
+    static const char *const geo =
+        "dimension 3;\nparticleSpacing 0.02;\n"
+        "fluidBlocks { water { type box; min (0 0 0); max (0.1 0.1 0.1); fluid water; } }\n"
+        "walls { tank { type box; min (0 0 0); max (0.4 0.4 0.4); } }\n"
+        "obstacles { body { type mesh; file \"body.obj\";\n"
+        " motion { type rigid; density 500; } } }\n";
+    const char *const objs[2] = {open_obj, inward};
+    const char *const want[2] = {"not a closed surface", "inside out (signed volume -0.000512"};
+    for (int k = 0; k < 2; k++) {
+        tc_case c;
+        CHECK_OK(tc_case_from_strings(&c, exe, "bodies3d-refused", ctl, TC_MOMENTUM_SOLVER,
+                                      fluids, geo));
+        CHECK_OK(tc_case_write(&c, "constant/body.obj", objs[k]));
+        const int status = tc_case_run(&c, NULL, NULL);
+        const bool said = tc_case_log_contains(&c, want[k]) &&
+                          tc_case_log_contains(&c, "constant/geometry:5:13: obstacle 'body'") &&
+                          tc_case_log_contains(&c, "body.obj");
+        printf("mesh refused: %s: exit %d, the message %s\n", k ? "inside out" : "open", status,
+               said ? "found" : "missing");
+        CHECK(status != 0 && said);
+        if (!said)
+            tc_case_log_tail(&c, 12);
+        tc_case_destroy(&c);
+    }
 }
 
 /* A box [lo, hi] as 12 outward-wound triangles, each vertex turned by R
@@ -429,10 +486,22 @@ int main(int argc, char **argv)
         return 2;
     }
     const char *only = argc > 2 ? argv[2] : ""; /* a part's name: that part alone */
-    if (!*only || strcmp(only, "mass") == 0)
+    if (!*only || strcmp(only, "mass") == 0) {
         check_mesh_mass();
-    if (!*only || strcmp(only, "momentum") == 0)
-        check_cylinder_momentum(argv[1]);
+        check_mesh_refused(argv[1]);
+    }
+    if (!*only || strcmp(only, "momentum") == 0) {
+        /* the cylinder: radius 0.03, length 0.04 (caps half a spacing off
+         * the lattice's planes, as the mesh's faces) */
+        check_momentum(argv[1], "cylinder momentum", (const double[]){0.17, 0.17, 0.18},
+                       (const double[]){0.23, 0.23, 0.22},
+                       "type cylinder; centre (0.2 0.2 0.2); radius 0.03; axis (0 0 1); "
+                       "length 0.04;", NULL, 1000 * M_PI * 0.03 * 0.03 * 0.04);
+        /* the file's vertices through assimp's single precision (ai_real) */
+        check_momentum(argv[1], "mesh box momentum", (const double[]){0.16, 0.16, 0.16},
+                       (const double[]){0.24, 0.24, 0.24}, "type mesh; file \"body.obj\";",
+                       cube_obj, 1000 * pow((double)0.24f - (double)0.16f, 3));
+    }
     if (!*only || strcmp(only, "float") == 0)
         check_cylinder_float(argv[1]);
     return mf_test_summary("bodies3d");
