@@ -126,30 +126,45 @@ static double section_below(double R, double s)
     return R * R * acos(-s / R) + s * sqrt(R * R - s * s);
 }
 
-static void check_cylinder_float(const char *exe)
+/* The section of a rectangle W wide and H high below a level s above its
+ * centre. */
+static double rectangle_below(double W, double H, double s)
 {
-    const double l0 = 0.02, R = 0.05, L = 0.12, A = 0.3 * 0.2;
+    return W * fmax(0, fmin(H, s + 0.5 * H));
+}
+
+/* A body of density 500 (its entry `obstacle`, named body; obj: a polygon
+ * file constant/body.obj, NULL: none) released above water 0.16 m deep in
+ * a tank 0.3 x 0.2 m, l0 = 0.02 m: the mean of its centre's y over t in
+ * (0.5, 1) s against the mean level h = (V_f + L S(h - y_c)) / A, S the
+ * section (S_cyl: circle of radius R; else a rectangle W x H), L its
+ * length along z; mass its mass from its shape. */
+static void check_float(const char *exe, const char *what, const char *obstacle,
+                        const char *obj, double mass, double R, double W, double H, double L)
+{
+    const double l0 = 0.02, A = 0.3 * 0.2;
     static const char *const ctl =
         "endTime 1.0;\ndeltaT 1e-4;\nadjustTimeStep yes;\nmaxCo 0.2;\nmaxDeltaT 1e-3;\n"
         "writeControl adjustableRunTime;\nwriteInterval 0.5;\n";
     static const char *const slv = "solver MPS;\n"
                                    "pressure { solver PCG_BoomerAMG; tolerance 1e-8; }\n"
                                    "forces { gravity { g (0 -9.81 0); } }\n";
-    /* the caps at z = 0.04 and 0.16, half a spacing from the lattice's
-     * planes (a cap on a plane has its particles l0 inside it) */
-    static const char *const geo =
-        "dimension 3;\nparticleSpacing 0.02;\n"
-        "fluidBlocks { water { type box; min (0 0 0); max (0.3 0.16 0.2); fluid water; } }\n"
-        "walls { tank { type box; min (0 0 0); max (0.3 0.35 0.2); open (ymax); } }\n"
-        "obstacles { cylinder { type cylinder; centre (0.15 0.215 0.1); radius 0.05;\n"
-        " axis (0 0 1); length 0.12; motion { type rigid; density 500; g (0 -9.81 0); } } }\n";
+    char geo[2048];
+    snprintf(geo, sizeof geo,
+             "dimension 3;\nparticleSpacing 0.02;\n"
+             "fluidBlocks { water { type box; min (0 0 0); max (0.3 0.16 0.2); fluid water; } }\n"
+             "walls { tank { type box; min (0 0 0); max (0.3 0.35 0.2); open (ymax); } }\n"
+             "obstacles { body { %s\n"
+             " motion { type rigid; density 500; g (0 -9.81 0); } } }\n", obstacle);
     tc_case c;
     CHECK_OK(tc_case_from_strings(&c, exe, "bodies3d-float", ctl, slv, fluids, geo));
+    if (obj)
+        CHECK_OK(tc_case_write(&c, "constant/body.obj", obj));
     track tr = {0};
-    bool ok = run(&c, "cylinder float");
+    bool ok = run(&c, what);
     if (ok) {
-        ok = read_track(c.dir, "cylinder", &tr) == 0;
-        CHECK_MSG(ok, "cylinder float: no bodyState.csv rows");
+        ok = read_track(c.dir, "body", &tr) == 0;
+        CHECK_MSG(ok, "%s: no bodyState.csv rows", what);
     }
     tc_snapshots s = {0};
     if (ok) {
@@ -169,22 +184,23 @@ static void check_cylinder_float(const char *exe)
             const double dt = tr.t[k] - tr.t[k - 1], y = tr.x[3 * k + 1];
             double hk = Vf / A;
             for (int it = 0; it < 50; it++)
-                hk = (Vf + L * section_below(R, hk - y)) / A;
+                hk = (Vf + L * (R > 0 ? section_below(R, hk - y) : rectangle_below(W, H, hk - y))) / A;
             yc += y * dt;
             level += hk * dt;
             span += dt;
         }
         yc /= span;
         level /= span;
-        printf("cylinder float: mass %.6g kg, %.0f fluid particles' volume %.6g m^3: mean centre "
+        printf("%s: mass %.6g kg, %.0f fluid particles' volume %.6g m^3: mean centre "
                "y = %.5f m, mean level %.5f m over t in (0.5, %.3g) s: %.3g l0 off (tolerance "
-               "0.3 l0)\n", tr.mass, Vf / (l0 * l0 * l0), Vf, yc, level, tr.t[tr.n - 1],
+               "0.3 l0)\n", what, tr.mass, Vf / (l0 * l0 * l0), Vf, yc, level, tr.t[tr.n - 1],
                (yc - level) / l0);
-        CHECK(fabs(tr.mass / (500 * M_PI * R * R * L) - 1) < 1e-8); /* 9 digits */
+        CHECK_MSG(fabs(tr.mass / mass - 1) < 1e-8, "%s: mass %.9g, its shape's %.9g", what,
+                  tr.mass, mass); /* 9 digits */
         CHECK(fabs(tr.t[tr.n - 1] - 1.0) < 1e-9);
         CHECK(fabs(yc - level) < 0.3 * l0);
     } else {
-        CHECK_MSG(false, "cylinder float: no snapshot to read");
+        CHECK_MSG(false, "%s: no snapshot to read", what);
     }
     tc_snapshots_free(&s);
     if (tr.n > 0)
@@ -335,6 +351,13 @@ static void check_mesh_refused(const char *exe)
         tc_case_destroy(&c);
     }
 }
+
+/* A box x 0.08..0.2, y 0.18..0.24, z 0.04..0.16, outward-wound. */
+static const char *const float_box_obj =
+    "v 0.08 0.18 0.04\nv 0.20 0.18 0.04\nv 0.08 0.24 0.04\nv 0.20 0.24 0.04\n"
+    "v 0.08 0.18 0.16\nv 0.20 0.18 0.16\nv 0.08 0.24 0.16\nv 0.20 0.24 0.16\n"
+    "f 1 3 2\nf 2 3 4\nf 5 6 7\nf 6 8 7\nf 1 2 5\nf 2 6 5\n"
+    "f 3 7 4\nf 4 7 8\nf 1 5 3\nf 3 5 7\nf 2 4 6\nf 4 8 6\n";
 
 /* A box [lo, hi] as 12 outward-wound triangles, each vertex turned by R
  * about c (R NULL: not turned). */
@@ -502,7 +525,23 @@ int main(int argc, char **argv)
                        (const double[]){0.24, 0.24, 0.24}, "type mesh; file \"body.obj\";",
                        cube_obj, 1000 * pow((double)0.24f - (double)0.16f, 3));
     }
-    if (!*only || strcmp(only, "float") == 0)
-        check_cylinder_float(argv[1]);
+    if (!*only || strcmp(only, "float") == 0) {
+        /* the cylinder: its caps at z = 0.04 and 0.16, half a spacing off
+         * the lattice's planes (a cap on a plane has its particles l0
+         * inside it); released with its lowest line 0.005 m above the water */
+        const double R = 0.05, L = 0.12;
+        check_float(argv[1], "cylinder float",
+                    "type cylinder; centre (0.15 0.215 0.1); radius 0.05; axis (0 0 1); "
+                    "length 0.12;", NULL, 500 * M_PI * R * R * L, R, 0, 0, L);
+    }
+    if (!*only || strcmp(only, "meshfloat") == 0) {
+        /* the mesh box 0.12 wide, 0.06 high, 0.12 long (stable upright:
+         * B^2/(12 d) > (H - d)/2), its bottom 0.02 m above the water; its
+         * vertices through assimp's single precision */
+        const double W = (double)0.20f - (double)0.08f, H = (double)0.24f - (double)0.18f,
+                     L = (double)0.16f - (double)0.04f;
+        check_float(argv[1], "mesh box float", "type mesh; file \"body.obj\";", float_box_obj,
+                    500 * W * H * L, 0, W, H, L);
+    }
     return mf_test_summary("bodies3d");
 }

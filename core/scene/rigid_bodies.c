@@ -611,6 +611,8 @@ int mf_body_surface_prepare(mf_wall *w, const mf_particles *p, int f_wall_id, in
         const int nf = surface_faces(w, dim, xb, depth, normal);
         for (int f = 0; f < nf; f++)
             count[f] += stands_for(depth[f], l0);
+        if (w->shape == MF_SOLID_MESH) /* its outer particles (no faces: count[0]) */
+            count[0] += stands_for(-mf_wall_body_distance(w, xb, normal[0]), l0);
     }
     /* the counts over every rank's owned particles (whole numbers: exact) */
     double counts[7] = {count[0], count[1], count[2], count[3], count[4], count[5], nround};
@@ -632,10 +634,20 @@ int mf_body_surface_prepare(mf_wall *w, const mf_particles *p, int f_wall_id, in
             return MF_ERROR(MF_ERR_INPUT, "%s: rigid body '%s' has no wall particle", w->where,
                             w->name);
         b->round_area = area / nround;
+    } else if (w->shape == MF_SOLID_MESH && w->mesh && dim == 3) {
+        /* the mesh's whole area over its outer particles, each with the
+         * normal at its nearest point (mf_body_surface) */
+        mf_trimesh_report r;
+        MF_CALL(mf_wall_mesh_report(w->mesh, &r));
+        if (count[0] == 0)
+            return MF_ERROR(MF_ERR_INPUT, "%s: rigid body '%s' has no wall particle within l0 "
+                            "of its surface", w->where, w->name);
+        b->round_area = r.area / count[0];
     } else {
         return MF_ERROR(MF_ERR_INPUT, "%s: rigid body '%s': the fluid's pressure on it is "
-                        "summed for boxes, cylinders and spheres only so far (a mesh is not "
-                        "yet)", w->where, w->name);
+                        "summed for boxes, cylinders, spheres and 3-D meshes only (a 2-D mesh "
+                        "body: use gradient corrected, whose pair reaction needs no surface)",
+                        w->where, w->name);
     }
     b->surface_ready = true;
     return 0;
@@ -666,6 +678,17 @@ int mf_body_surface(const mf_wall *w, const double x[3], double l0, double out_a
             n++;
         }
         return n;
+    }
+    if (w->shape == MF_SOLID_MESH) { /* depth -d along the normal into the fluid */
+        const double d = mf_wall_body_distance(w, xb, nb);
+        if (!stands_for(-d, l0))
+            return 0;
+        mf_mat3_vec(w->state.R, nb, out_area[0]);
+        for (int a = 0; a < 3; a++) {
+            out_shift[0][a] = -d * out_area[0][a];
+            out_area[0][a] *= b->round_area;
+        }
+        return 1;
     }
     double r2 = 0;
     for (int a = 0; a < dim; a++)
