@@ -502,6 +502,64 @@ static void check_mesh_mass(void)
     mf_trimesh_free(&m);
 }
 
+/* Friction (body_contact.c): a box 0.1 x 0.05 m (2-D, density 500) on the
+ * floor of a dry tank set sliding at v = 1 m/s: with friction mu it stops
+ * after v^2/(2 mu g) (0.102 m at mu 0.5, in v/(mu g) = 0.20 s), within a
+ * spacing; with friction 0 (the default) it slides on at v. */
+static void check_friction(const char *exe)
+{
+    const double l0 = 0.01, v = 1, g = 9.81;
+    static const char *const ctl =
+        "endTime 0.4;\ndeltaT 1e-4;\nadjustTimeStep yes;\nmaxCo 0.2;\nmaxDeltaT 1e-3;\n"
+        "writeControl adjustableRunTime;\nwriteInterval 0.1;\n";
+    static const char *const slv = "solver MPS;\n"
+                                   "pressure { solver PCG_BoomerAMG; tolerance 1e-8; }\n"
+                                   "forces { gravity { g (0 -9.81 0); } }\n";
+    const double mus[2] = {0.5, 0};
+    for (int k = 0; k < 2; k++) {
+        char geo[2048];
+        /* a puddle in a corner: a case needs fluid */
+        snprintf(geo, sizeof geo,
+                 "dimension 2;\nparticleSpacing 0.01;\n"
+                 "fluidBlocks { water { type box; min (0 0 0); max (0.05 0.05 0); fluid water; } }\n"
+                 "walls { tank { type box; min (0 0 0); max (0.8 0.3 0); open (ymax); } }\n"
+                 "obstacles { body { type box; min (0.2 0 0); max (0.3 0.05 0);\n"
+                 " motion { type rigid; density 500; velocity (%g 0 0); friction %g; } } }\n",
+                 v, mus[k]);
+        tc_case c;
+        CHECK_OK(tc_case_from_strings(&c, exe, "bodies3d-friction", ctl, slv, fluids, geo));
+        track tr = {0};
+        bool ok = run(&c, "friction");
+        if (ok) {
+            ok = read_track(c.dir, "body", &tr) == 0;
+            CHECK_MSG(ok, "friction: no bodyState.csv rows");
+        }
+        if (ok) {
+            const size_t e = tr.n - 1;
+            const double moved = tr.x[3 * e] - tr.x[0], vx = tr.v[3 * e];
+            double stop = NAN; /* the first row at rest */
+            for (size_t r = 0; r < tr.n && isnan(stop); r++)
+                if (fabs(tr.v[3 * r]) < 1e-6)
+                    stop = tr.t[r];
+            if (mus[k] > 0) {
+                const double want = v * v / (2 * mus[k] * g);
+                printf("friction %g: moved %.5f m (v^2/(2 mu g) = %.5f m), at rest from t = %.4g "
+                       "s (v/(mu g) = %.4g s), vx at t = %g: %.3g m/s\n", mus[k], moved, want,
+                       stop, v / (mus[k] * g), tr.t[e], vx);
+                CHECK(fabs(moved - want) < l0);
+                CHECK(fabs(vx) < 1e-6);
+            } else {
+                printf("friction 0: moved %.5f m in %g s, vx %.6f m/s\n", moved, tr.t[e], vx);
+                CHECK(fabs(vx - v) < 1e-6 && fabs(moved - v * tr.t[e]) < l0);
+            }
+            CHECK(fabs(tr.t[e] - 0.4) < 1e-9);
+        }
+        if (tr.n > 0)
+            track_free(&tr);
+        tc_case_destroy(&c);
+    }
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -525,6 +583,8 @@ int main(int argc, char **argv)
                        (const double[]){0.24, 0.24, 0.24}, "type mesh; file \"body.obj\";",
                        cube_obj, 1000 * pow((double)0.24f - (double)0.16f, 3));
     }
+    if (!*only || strcmp(only, "friction") == 0)
+        check_friction(argv[1]);
     if (!*only || strcmp(only, "float") == 0) {
         /* the cylinder: its caps at z = 0.04 and 0.16, half a spacing off
          * the lattice's planes (a cap on a plane has its particles l0
