@@ -45,71 +45,6 @@ static const char *const fluids = "water { rho 1000; nu 1e-6; }\n";
 /* test_bodies' momentum fluid: viscous enough to drag the body in 0.2 s */
 static const char *const viscous = "water { rho 1000; nu 1e-4; }\n";
 
-/* Rows of postProcessing/<body>/bodyState.csv: time, centre, velocity,
- * force (3 each). */
-typedef struct track {
-    size_t n;
-    double *t, *x, *v, *f; /* n, 3n, 3n, 3n */
-    double mass;
-} track;
-
-static void track_free(track *tr)
-{
-    free(tr->t);
-    free(tr->x);
-    free(tr->v);
-    free(tr->f);
-}
-
-static int read_track(const char *dir, const char *body, track *tr)
-{
-    char path[1024];
-    snprintf(path, sizeof path, "%s/postProcessing/%s/bodyState.csv", dir, body);
-    memset(tr, 0, sizeof *tr);
-    FILE *f = fopen(path, "r");
-    if (!f)
-        return -1;
-    size_t cap = 0;
-    char line[4096];
-    while (fgets(line, sizeof line, f)) {
-        if (line[0] == '#') {
-            const char *m = strstr(line, "mass ");
-            if (m)
-                tr->mass = atof(m + 5);
-            continue;
-        }
-        double c[20];
-        int k = 0;
-        for (char *s = line, *e; k < 20; k++, s = e + 1) {
-            c[k] = strtod(s, &e);
-            if (e == s || (*e != ',' && k < 19))
-                break;
-        }
-        if (k < 19)
-            continue;
-        if (tr->n == cap) {
-            cap = cap ? 2 * cap : 256;
-            tr->t = realloc(tr->t, cap * sizeof *tr->t);
-            tr->x = realloc(tr->x, 3 * cap * sizeof *tr->x);
-            tr->v = realloc(tr->v, 3 * cap * sizeof *tr->v);
-            tr->f = realloc(tr->f, 3 * cap * sizeof *tr->f);
-            if (!tr->t || !tr->x || !tr->v || !tr->f) {
-                fclose(f);
-                return -1;
-            }
-        }
-        tr->t[tr->n] = c[0];
-        for (int a = 0; a < 3; a++) {
-            tr->x[3 * tr->n + a] = c[1 + a];
-            tr->v[3 * tr->n + a] = c[8 + a];
-            tr->f[3 * tr->n + a] = c[14 + a];
-        }
-        tr->n++;
-    }
-    fclose(f);
-    return tr->n > 1 && tr->mass > 0 ? 0 : -1;
-}
-
 static bool run(tc_case *c, const char *what)
 {
     int status = tc_case_run(c, NULL, NULL);
@@ -117,6 +52,20 @@ static bool run(tc_case *c, const char *what)
     if (status != 0)
         tc_case_log_tail(c, 20);
     return status == 0;
+}
+
+/* Write obj (NULL: none) to constant/body.obj, run the case and read the
+ * body's track; false (reported) when either fails. */
+static bool run_body(tc_case *c, const char *what, const char *obj, tc_body_track *tr)
+{
+    if (obj)
+        CHECK_OK(tc_case_write(c, "constant/body.obj", obj));
+    bool ok = run(c, what);
+    if (ok) {
+        ok = tc_body_track_read(c->dir, "body", tr) == 0;
+        CHECK_MSG(ok, "%s: no bodyState.csv rows", what);
+    }
+    return ok;
 }
 
 /* The section of a circle of radius R below a level s above its centre. */
@@ -158,14 +107,8 @@ static void check_float(const char *exe, const char *what, const char *obstacle,
              " motion { type rigid; density 500; g (0 -9.81 0); } } }\n", obstacle);
     tc_case c;
     CHECK_OK(tc_case_from_strings(&c, exe, "bodies3d-float", ctl, slv, fluids, geo));
-    if (obj)
-        CHECK_OK(tc_case_write(&c, "constant/body.obj", obj));
-    track tr = {0};
-    bool ok = run(&c, what);
-    if (ok) {
-        ok = read_track(c.dir, "body", &tr) == 0;
-        CHECK_MSG(ok, "%s: no bodyState.csv rows", what);
-    }
+    tc_body_track tr = {0};
+    bool ok = run_body(&c, what, obj, &tr);
     tc_snapshots s = {0};
     if (ok) {
         CHECK_OK(tc_snapshots_list(c.dir, &s));
@@ -204,7 +147,7 @@ static void check_float(const char *exe, const char *what, const char *obstacle,
     }
     tc_snapshots_free(&s);
     if (tr.n > 0)
-        track_free(&tr);
+        tc_body_track_free(&tr);
     tc_case_destroy(&c);
 }
 
@@ -238,14 +181,8 @@ static void check_momentum(const char *exe, const char *what, const double lo[3]
     tc_case c;
     CHECK_OK(tc_case_from_strings(&c, exe, "bodies3d-momentum", ctl, TC_MOMENTUM_SOLVER,
                                   viscous, geo));
-    if (obj)
-        CHECK_OK(tc_case_write(&c, "constant/body.obj", obj));
-    track tr = {0};
-    bool ok = run(&c, what);
-    if (ok) {
-        ok = read_track(c.dir, "body", &tr) == 0;
-        CHECK_MSG(ok, "%s: no bodyState.csv rows", what);
-    }
+    tc_body_track tr = {0};
+    bool ok = run_body(&c, what, obj, &tr);
     if (ok) {
         tc_snapshots s;
         CHECK_OK(tc_snapshots_list(c.dir, &s));
@@ -296,7 +233,7 @@ static void check_momentum(const char *exe, const char *what, const double lo[3]
          * (p = 0); still 1e6 times the tolerance */
         CHECK_MSG(vl < 0.99 * U && impulse > 0.01 * P0,
                   "%s: no exchange with the fluid (%g of %g m/s)", what, vl, U);
-        track_free(&tr);
+        tc_body_track_free(&tr);
     }
     tc_case_destroy(&c);
 }
@@ -528,12 +465,8 @@ static void check_friction(const char *exe)
                  v, mus[k]);
         tc_case c;
         CHECK_OK(tc_case_from_strings(&c, exe, "bodies3d-friction", ctl, slv, fluids, geo));
-        track tr = {0};
-        bool ok = run(&c, "friction");
-        if (ok) {
-            ok = read_track(c.dir, "body", &tr) == 0;
-            CHECK_MSG(ok, "friction: no bodyState.csv rows");
-        }
+        tc_body_track tr = {0};
+        const bool ok = run_body(&c, "friction", NULL, &tr);
         if (ok) {
             const size_t e = tr.n - 1;
             const double moved = tr.x[3 * e] - tr.x[0], vx = tr.v[3 * e];
@@ -555,7 +488,7 @@ static void check_friction(const char *exe)
             CHECK(fabs(tr.t[e] - 0.4) < 1e-9);
         }
         if (tr.n > 0)
-            track_free(&tr);
+            tc_body_track_free(&tr);
         tc_case_destroy(&c);
     }
 }
