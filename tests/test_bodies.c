@@ -64,73 +64,6 @@ static const char *const control =
     "endTime 0.2;\ndeltaT 1e-4;\nadjustTimeStep yes;\nmaxCo 0.2;\nmaxDeltaT 1e-3;\n"
     "writeControl adjustableRunTime;\nwriteInterval 0.02;\n";
 static const char *const fluids = "water { rho 1000; nu 1e-4; }\n";
-/* Rows of bodyState.csv: time, velocity (vx vy), force (Fx Fy). */
-typedef struct track {
-    size_t n;
-    double *t, *v, *f; /* n, 2n, 2n */
-    double mass;
-} track;
-
-/* The 20 numbers of a row of bodyState.csv (false: a comment or header). */
-static bool csv_row(char *line, double c[20])
-{
-    int k = 0;
-    for (char *s = line, *e; k < 20; k++, s = e + 1) {
-        c[k] = strtod(s, &e);
-        if (e == s || (*e != ',' && k < 19))
-            break;
-    }
-    return k >= 19;
-}
-
-static int read_track(const char *dir, track *tr)
-{
-    char path[1024];
-    snprintf(path, sizeof path, "%s/postProcessing/body/bodyState.csv", dir);
-    FILE *f = fopen(path, "r");
-    if (!f)
-        return -1;
-    memset(tr, 0, sizeof *tr);
-    size_t cap = 0;
-    char line[4096];
-    while (fgets(line, sizeof line, f)) {
-        if (line[0] == '#') {
-            const char *m = strstr(line, "mass ");
-            if (m)
-                tr->mass = atof(m + 5);
-            continue;
-        }
-        double c[20];
-        if (!csv_row(line, c))
-            continue;
-        if (tr->n == cap) {
-            cap = cap ? 2 * cap : 256;
-            tr->t = realloc(tr->t, cap * sizeof *tr->t);
-            tr->v = realloc(tr->v, 2 * cap * sizeof *tr->v);
-            tr->f = realloc(tr->f, 2 * cap * sizeof *tr->f);
-            if (!tr->t || !tr->v || !tr->f) {
-                fclose(f);
-                return -1;
-            }
-        }
-        tr->t[tr->n] = c[0];
-        tr->v[2 * tr->n] = c[8];
-        tr->v[2 * tr->n + 1] = c[9];
-        tr->f[2 * tr->n] = c[14];
-        tr->f[2 * tr->n + 1] = c[15];
-        tr->n++;
-    }
-    fclose(f);
-    return tr->n > 1 && tr->mass > 0 ? 0 : -1;
-}
-
-static void track_free(track *tr)
-{
-    free(tr->t);
-    free(tr->v);
-    free(tr->f);
-}
-
 /* Attribute `name` (n doubles) of /RigidBodies/<body> in snapshot `path`. */
 static int body_attribute(const char *path, const char *body, const char *name, double *v)
 {
@@ -166,10 +99,10 @@ static void check_momentum(const char *exe)
     tc_case c;
     CHECK_OK(tc_case_from_strings(&c, exe, "bodies-momentum", control, TC_MOMENTUM_SOLVER, fluids,
                                   geo));
-    track tr;
+    tc_body_track tr;
     bool ok = run(&c, "momentum");
     if (ok) {
-        ok = read_track(c.dir, &tr) == 0;
+        ok = tc_body_track_read(c.dir, "body", &tr) == 0;
         CHECK_MSG(ok, "momentum: no postProcessing/body/bodyState.csv with rows");
     }
     if (ok) {
@@ -195,20 +128,20 @@ static void check_momentum(const char *exe)
             while (row + 1 < tr.n && tr.t[row] < h.time * (1 - 1e-12)) {
                 row++;
                 const double dt = tr.t[row] - tr.t[row - 1];
-                impulse += hypot(tr.f[2 * row], tr.f[2 * row + 1]) * dt;
+                impulse += hypot(tr.f[3 * row], tr.f[3 * row + 1]) * dt;
             }
             if (fabs(tr.t[row] - h.time) > 1e-9 * fmax(1, h.time))
                 continue;
             const double dt = row > 0 ? tr.t[row] - tr.t[row - 1] : 0;
             for (int a = 0; a < 2; a++)
-                P[a] += tr.mass * tr.v[2 * row + a] + tr.f[2 * row + a] * dt;
+                P[a] += tr.mass * tr.v[3 * row + a] + tr.f[3 * row + a] * dt;
             const double err = hypot(P[0] - P0, P[1]);
             worst = fmax(worst, err);
             if (impulse > 0)
                 worst_ratio = fmax(worst_ratio, err / impulse);
             printf("t = %.3f: P = (%.6g %.6g) kg m/s (P(0) = %.6g), body v = %.5f m/s, "
                    "|P - P(0)| = %.3g = %.3g of the impulse %.4g\n",
-                   h.time, P[0], P[1], P0, tr.v[2 * row], err, impulse > 0 ? err / impulse : 0,
+                   h.time, P[0], P[1], P0, tr.v[3 * row], err, impulse > 0 ? err / impulse : 0,
                    impulse);
             CHECK_MSG(err <= MOMENTUM_TOL * P0,
                       "momentum: t = %g: |P - P(0)| = %g above %g P(0) (the impulse exchanged: "
@@ -220,7 +153,7 @@ static void check_momentum(const char *exe)
             tc_snapshot_path(c.dir, s.index[s.n - 1], path, sizeof path);
             double v[3] = {NAN, NAN, NAN};
             CHECK_OK(body_attribute(path, "body", "Velocity", v));
-            const double vl = tr.v[2 * (tr.n - 1)];
+            const double vl = tr.v[3 * (tr.n - 1)];
             printf("snapshot: /RigidBodies/body Velocity (%.9g %.9g), the CSV's last row %.9g\n",
                    v[0], v[1], vl);
             CHECK(fabs(v[0] - vl) <= 1e-8 * fabs(vl) && fabs(v[1]) < 1e-12);
@@ -228,12 +161,12 @@ static void check_momentum(const char *exe)
         tc_snapshots_free(&s);
         CHECK_MSG(checked >= 5, "momentum: only %zu snapshots matched the body's rows", checked);
         /* the body must have exchanged momentum at all for this to mean anything */
-        CHECK_MSG(tr.v[2 * (tr.n - 1)] < 0.95 * U && impulse > 0.05 * P0,
+        CHECK_MSG(tr.v[3 * (tr.n - 1)] < 0.95 * U && impulse > 0.05 * P0,
                   "momentum: the body kept its velocity (%g of %g m/s): no exchange with the "
-                  "fluid", tr.v[2 * (tr.n - 1)], U);
+                  "fluid", tr.v[3 * (tr.n - 1)], U);
         printf("momentum: worst |P - P(0)| %.3g kg m/s = %.3g P(0) (tolerance %.2g P(0)), %.3g of "
                "the impulse exchanged\n", worst, worst / P0, MOMENTUM_TOL, worst_ratio);
-        track_free(&tr);
+        tc_body_track_free(&tr);
     }
     tc_case_destroy(&c);
 }
@@ -245,19 +178,19 @@ static void check_rest(const char *exe)
     tc_case c;
     CHECK_OK(tc_case_from_strings(&c, exe, "bodies-rest", control, TC_MOMENTUM_SOLVER, fluids,
                                   geo));
-    track tr;
+    tc_body_track tr;
     bool ok = run(&c, "at rest");
     if (ok) {
-        ok = read_track(c.dir, &tr) == 0;
+        ok = tc_body_track_read(c.dir, "body", &tr) == 0;
         CHECK_MSG(ok, "at rest: no postProcessing/body/bodyState.csv with rows");
     }
     if (ok) {
         double vmax = 0;
         for (size_t k = 0; k < tr.n; k++)
-            vmax = fmax(vmax, hypot(tr.v[2 * k], tr.v[2 * k + 1]));
+            vmax = fmax(vmax, hypot(tr.v[3 * k], tr.v[3 * k + 1]));
         printf("at rest: the body's largest speed %.3g m/s\n", vmax);
         CHECK(vmax < 1e-6);
-        track_free(&tr);
+        tc_body_track_free(&tr);
     }
     tc_case_destroy(&c);
 }
@@ -373,7 +306,7 @@ static int last_row(const char *dir, const char *body, double row[5])
     int got = -1;
     while (fgets(line, sizeof line, f)) {
         double c[20];
-        if (!csv_row(line, c))
+        if (!tc_body_csv_row(line, c))
             continue;
         row[0] = c[0];
         row[1] = c[1];

@@ -18,8 +18,9 @@ typedef struct mf_body {
     /* the step being tried (mf_bodies_set_trial) */
     double xt[3], vt[3], Rt[9], Lt[3], wt[3];
     /* the surface its wall particles stand for (mf_body_surface_prepare):
-     * per box face (xmin xmax ymin ymax zmin zmax), or of a round shape, the
-     * area of the surface per wall particle within l0 of it */
+     * per box face (xmin xmax ymin ymax zmin zmax) or 3-D cylinder face
+     * (side, cap at -h, cap at +h), or of a round shape (disk, sphere) or a
+     * 3-D mesh, the area of the surface per wall particle within l0 of it */
     bool surface_ready;
     double face_area[6], round_area;
     FILE *csv;

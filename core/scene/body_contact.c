@@ -193,8 +193,55 @@ static void shift(mf_wall *w, int dim, const double s[3])
  * approach at the first sweep), its total lam[i] over the sweeps kept >= 0
  * (a contact pushes, never pulls: Catto's accumulated clamping). Returns
  * the largest change of an impulse, N s (2-D: per metre). */
+/* Coulomb friction at contact point x of A with B after its normal impulse
+ * (Catto 2005: the tangential impulse that stops the sliding velocity v_t,
+ * its total lt over the sweeps kept within the friction cone |lt| <= mu
+ * lam, lam the point's normal total). Returns the change of the impulse. */
+static double friction(mf_wall *A, mf_wall *B, int dim, double dt, const double x[3],
+                       const double n[3], double mu, double lam, double lt[3])
+{
+    mf_body *a = A->body, *b = B->body;
+    double va[3], vb[3] = {0, 0, 0};
+    inverse_mass(a, x, n, va);
+    if (b)
+        inverse_mass(b, x, n, vb);
+    else
+        mf_wall_velocity(B, x, true, vb);
+    const double rel[3] = {va[0] - vb[0], va[1] - vb[1], va[2] - vb[2]};
+    const double vn = rel[0] * n[0] + rel[1] * n[1] + rel[2] * n[2];
+    double vt[3], want[3];
+    for (int c = 0; c < 3; c++)
+        vt[c] = c < dim ? rel[c] - vn * n[c] : 0;
+    const double speed = sqrt(vt[0] * vt[0] + vt[1] * vt[1] + vt[2] * vt[2]);
+    memcpy(want, lt, sizeof want);
+    if (speed > 0) {
+        const double t[3] = {vt[0] / speed, vt[1] / speed, vt[2] / speed};
+        double ua[3], ub[3];
+        double k = inverse_mass(a, x, t, ua);
+        if (b)
+            k += inverse_mass(b, x, t, ub);
+        for (int c = 0; c < 3; c++)
+            want[c] -= speed / k * t[c];
+    }
+    const double len = sqrt(want[0] * want[0] + want[1] * want[1] + want[2] * want[2]);
+    if (len > mu * lam)
+        for (int c = 0; c < 3; c++)
+            want[c] *= mu * lam / len;
+    const double dj[3] = {want[0] - lt[0], want[1] - lt[1], want[2] - lt[2]};
+    const double mdj[3] = {-dj[0], -dj[1], -dj[2]};
+    memcpy(lt, want, sizeof want);
+    const double change = sqrt(dj[0] * dj[0] + dj[1] * dj[1] + dj[2] * dj[2]);
+    if (change > 0) {
+        apply(A, dim, dt, x, dj);
+        if (b)
+            apply(B, dim, dt, x, mdj);
+    }
+    return change;
+}
+
 static double sweep(mf_walls *ws, const body_points *p, size_t ka, size_t kb, double e,
-                    double dt, bool first, double *lam, double *target, double *normal)
+                    double mu, double dt, bool first, double *lam, double *target,
+                    double *normal, double *lt)
 {
     mf_wall *A = &ws->w[ka], *B = &ws->w[kb];
     const int dim = ws->dim;
@@ -213,6 +260,7 @@ static double sweep(mf_walls *ws, const body_points *p, size_t ka, size_t kb, do
         /* the contact points and normals are those of the first sweep */
         if (first) {
             lam[i] = 0;
+            lt[3 * i] = lt[3 * i + 1] = lt[3 * i + 2] = 0;
             target[i] = NAN;
             const double delta = 0.5 * ws->l0 - mf_wall_distance(B, x, &normal[3 * i]);
             if (!(delta > 0) || !isfinite(delta))
@@ -233,20 +281,22 @@ static double sweep(mf_walls *ws, const body_points *p, size_t ka, size_t kb, do
         const double next = fmax(lam[i] + (target[i] - vn) / k, 0);
         const double j = next - lam[i];
         lam[i] = next;
-        if (j == 0)
-            continue;
-        const double jn[3] = {j * n[0], j * n[1], j * n[2]};
-        const double mjn[3] = {-jn[0], -jn[1], -jn[2]};
-        apply(A, dim, dt, x, jn);
-        if (b)
-            apply(B, dim, dt, x, mjn);
-        change = fmax(change, fabs(j));
+        if (j != 0) {
+            const double jn[3] = {j * n[0], j * n[1], j * n[2]};
+            const double mjn[3] = {-jn[0], -jn[1], -jn[2]};
+            apply(A, dim, dt, x, jn);
+            if (b)
+                apply(B, dim, dt, x, mjn);
+            change = fmax(change, fabs(j));
+        }
+        if (mu > 0) /* mu 0: no friction, the frictionless results unchanged */
+            change = fmax(change, friction(A, B, dim, dt, x, n, mu, lam[i], &lt[3 * i]));
     }
     return change;
 }
 
 static void contact_pair(mf_walls *ws, const body_points *p, size_t ka, size_t kb, double dt,
-                         bool bounce, double *lam, double *target, double *normal)
+                         bool bounce, double *lam, double *target, double *normal, double *lt)
 {
     mf_wall *A = &ws->w[ka], *B = &ws->w[kb];
     mf_body *a = A->body, *b = B->body;
@@ -257,13 +307,14 @@ static void contact_pair(mf_walls *ws, const body_points *p, size_t ka, size_t k
     const double e = !bounce ? 0
                      : b     ? 0.5 * (A->motion.restitution + B->motion.restitution)
                              : A->motion.restitution;
+    const double mu = b ? 0.5 * (A->motion.friction + B->motion.friction) : A->motion.friction;
     /* until the impulses change by less than 1e-9 of the body's momentum
      * scale m sqrt(g l0), or CONTACT_SWEEPS */
     const double g = sqrt(A->motion.g[0] * A->motion.g[0] + A->motion.g[1] * A->motion.g[1] +
                           A->motion.g[2] * A->motion.g[2]);
     const double tol = 1e-9 * a->mass * fmax(sqrt(g * ws->l0), 1e-3);
     for (int s = 0; s < CONTACT_SWEEPS; s++)
-        if (!(sweep(ws, p, ka, kb, e, dt, s == 0, lam, target, normal) > tol))
+        if (!(sweep(ws, p, ka, kb, e, mu, dt, s == 0, lam, target, normal, lt) > tol))
             break;
     /* the overlap left at the new trial states */
     const double delta = overlap(ws, p, ka, B, x, n);
@@ -287,8 +338,9 @@ int mf_bodies_contact(mf_walls *ws, const mf_particles *p, double dt)
     MF_CALL(gather_points(ws, p, &pts));
     const size_t n = pts.n ? pts.n : 1;
     double *lam = malloc(n * sizeof *lam), *target = malloc(n * sizeof *target);
-    double *normal = malloc(3 * n * sizeof *normal);
-    if (!lam || !target || !normal) {
+    double *normal = malloc(3 * n * sizeof *normal), *lt = malloc(3 * n * sizeof *lt);
+    if (!lam || !target || !normal || !lt) {
+        free(lt);
         free(lam);
         free(target);
         free(normal);
@@ -304,11 +356,12 @@ int mf_bodies_contact(mf_walls *ws, const mf_particles *p, double dt)
                 continue;
             for (size_t kb = 0; kb < ws->n; kb++)
                 if (kb != ka)
-                    contact_pair(ws, &pts, ka, kb, dt, pass == 0, lam, target, normal);
+                    contact_pair(ws, &pts, ka, kb, dt, pass == 0, lam, target, normal, lt);
         }
     free(pts.pt);
     free(lam);
     free(target);
     free(normal);
+    free(lt);
     return 0;
 }

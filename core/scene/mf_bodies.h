@@ -25,9 +25,10 @@
  * Contact: where a body's surface would overlap a wall, an obstacle or
  * another body at the trial state, the approach at the deepest point is
  * stopped by an impulse (restitution e: -(1+e) v_n over the pair's
- * effective mass, the collision of two rigid bodies without friction,
- * e.g. Baraff 1997, "An introduction to physically based modeling: rigid
- * body simulation II", eq. 8-18) and the overlap is removed from the trial
+ * effective mass, the collision of two rigid bodies, e.g. Baraff 1997,
+ * "An introduction to physically based modeling: rigid body simulation
+ * II", eq. 8-18; with `friction` mu a tangential impulse of at most mu
+ * times it, Catto 2005) and the overlap is removed from the trial
  * position (p holds the particles where the committed state has them).
  *
  * A retry of a step computes the trial state again from the committed state

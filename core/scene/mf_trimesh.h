@@ -119,6 +119,13 @@ typedef struct mf_trimesh_report {
  * (every triangle degenerate) is MF_ERR_INPUT. */
 int mf_trimesh_check(mf_trimesh *m, mf_trimesh_report *r);
 
+/* The solid a closed, outward-wound mesh bounds (core/scene/trimesh_mass.c,
+ * by the divergence theorem: Eberly 2002, Mirtich 1996): its signed volume
+ * (negative: wound inward), its centroid and its inertia tensor about the
+ * centroid per unit mass (row-major, m^2), exact for the polyhedron. The
+ * mesh is not checked: mf_trimesh_check says whether it is closed. */
+void mf_trimesh_mass(const mf_trimesh *m, double *volume, double centre[3], double I[9]);
+
 /* Generalized winding number of point x (van Oosterom & Strackee's solid
  * angle of each triangle over 4 pi): +1 inside a closed outward-wound
  * surface, -1 inward-wound, 0 outside; fractional for open surfaces. */

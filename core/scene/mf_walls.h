@@ -80,6 +80,7 @@ typedef struct mf_motion {
      * origin is the centre of mass (origin_given: the case gave it). */
     double density, mass, inertia[3], g[3];
     double restitution; /* rigid: of its contacts (body_contact.c) */
+    double friction;    /* rigid: Coulomb's mu of its contacts (0: none) */
     bool origin_given;
 } mf_motion;
 

@@ -15,6 +15,7 @@
 #include "mf_fs.h"
 #include "mf_parallel.h"
 #include "bodies_internal.h"
+#include "walls_internal.h"
 
 
 /* Inverse of a symmetric positive definite 3x3 matrix (the adjugate). */
@@ -35,6 +36,29 @@ static bool invert3(const double A[9], double B[9])
     B[7] = (A[1] * A[6] - A[0] * A[7]) / det;
     B[8] = (A[0] * A[4] - A[1] * A[3]) / det;
     return true;
+}
+
+/* A closed mesh's volume, centroid and inertia per unit mass
+ * (mf_trimesh_mass: Eberly 2002, Mirtich 1996); an open or inside-out
+ * surface is refused. */
+static int mesh_inertia(const mf_wall *w, double *volume, double centre[3], double I[9])
+{
+    const mf_trimesh *m = mf_wall_mesh_surface(w->mesh);
+    mf_trimesh_report r;
+    MF_CALL(mf_wall_mesh_report(w->mesh, &r));
+    mf_trimesh_mass(m, volume, centre, I);
+    if (!r.closed)
+        return MF_ERROR(MF_ERR_INPUT, "%s: obstacle '%s', file '%s': not a closed surface (%zu "
+                        "open edges, the first at (%g %g %g); %zu edges of three or more "
+                        "triangles; signed volume %g m^3): the mass of a rigid body from its "
+                        "density needs a closed mesh (or give mass, inertia and origin)",
+                        w->where, w->name, m->name, r.nboundary, r.at_boundary[0],
+                        r.at_boundary[1], r.at_boundary[2], r.nnonmanifold, *volume);
+    if (!(*volume > 0))
+        return MF_ERROR(MF_ERR_INPUT, "%s: obstacle '%s', file '%s': the surface is inside out "
+                        "(signed volume %g m^3: its triangles' normals (b - a) x (c - a) point "
+                        "inward): turn its triangles", w->where, w->name, m->name, *volume);
+    return 0;
 }
 
 /* Volume (2-D: area), the centre and the inertia per unit mass of a shape. */
@@ -86,9 +110,14 @@ static int shape_inertia(const mf_wall *w, int dim, double *volume, double centr
                                along * w->axis[i] * w->axis[j];
         return 0;
     }
-    return MF_ERROR(MF_ERR_INPUT, "%s: obstacle '%s': a rigid mesh body needs its mass, inertia "
-                    "and origin (the centre of mass) in motion { type rigid; mass ...; inertia "
-                    "(...); origin (...); } (density works for box, cylinder and sphere)",
+    if (w->shape == MF_SOLID_MESH && dim == 3 && w->mesh)
+        return mesh_inertia(w, volume, centre, I);
+    /* 2-D: a mesh obstacle is a profile extruded across z = 0 (walls_mesh.c),
+     * whose section the triangles do not give */
+    return MF_ERROR(MF_ERR_INPUT, "%s: obstacle '%s': a rigid mesh body in 2-D needs its mass, "
+                    "inertia and origin (the centre of mass) in motion { type rigid; mass ...; "
+                    "inertia (...); origin (...); } (its section is not computed from the "
+                    "extruded profile; density works for box, cylinder, sphere and 3-D meshes)",
                     w->where, w->name);
 }
 
@@ -490,13 +519,78 @@ int mf_body_set(mf_wall *w, const mf_body_momentum *s, const char *where)
     return 0;
 }
 
-/* Depth of body point xb below each face of a box (xmin xmax ymin ...). */
-static void face_depths(const mf_wall *w, int dim, const double xb[3], double depth[6])
+/* The flat-or-straight faces of a box or a 3-D cylinder, body frame: the
+ * depth of body point xb below each and its outward unit normal. A box:
+ * xmin xmax ymin ymax (zmin zmax); a cylinder (axis a, centre c, radius r,
+ * half-length h, xb - c = t a + rho e_r): the round side (depth r - rho,
+ * normal e_r) and the caps at -h and +h (depths t + h and h - t, normals
+ * -a and +a). Returns how many (0: a round shape, one element per wall
+ * particle: mf_body_surface's other branch). */
+static int face_count(const mf_wall *w, int dim)
 {
-    for (int a = 0; a < 3; a++) {
-        depth[2 * a] = a < dim ? xb[a] - w->min[a] : INFINITY;
-        depth[2 * a + 1] = a < dim ? w->max[a] - xb[a] : INFINITY;
+    return w->shape == MF_SOLID_BOX ? 2 * dim
+           : w->shape == MF_SOLID_CYLINDER && dim == 3 ? 3
+                                                       : 0;
+}
+
+static int surface_faces(const mf_wall *w, int dim, const double xb[3], double depth[6],
+                         double normal[6][3])
+{
+    memset(normal, 0, 6 * sizeof normal[0]);
+    if (w->shape == MF_SOLID_BOX) {
+        for (int a = 0; a < dim; a++) {
+            depth[2 * a] = xb[a] - w->min[a];
+            depth[2 * a + 1] = w->max[a] - xb[a];
+            normal[2 * a][a] = -1;
+            normal[2 * a + 1][a] = 1;
+        }
+        return face_count(w, dim);
     }
+    if (face_count(w, dim) == 0)
+        return 0;
+    const double *ax = w->axis;
+    double r[3], rad[3];
+    for (int a = 0; a < 3; a++)
+        r[a] = xb[a] - w->centre[a];
+    const double t = r[0] * ax[0] + r[1] * ax[1] + r[2] * ax[2];
+    for (int a = 0; a < 3; a++)
+        rad[a] = r[a] - t * ax[a];
+    const double rho = sqrt(rad[0] * rad[0] + rad[1] * rad[1] + rad[2] * rad[2]);
+    depth[0] = w->radius - rho;
+    depth[1] = t + w->half_length;
+    depth[2] = w->half_length - t;
+    for (int a = 0; a < 3; a++) {
+        normal[0][a] = rho > 0 ? rad[a] / rho : 0; /* on the axis: no side there */
+        normal[1][a] = -ax[a];
+        normal[2][a] = ax[a];
+    }
+    if (!(rho > 0))
+        depth[0] = INFINITY;
+    return face_count(w, dim);
+}
+
+/* A wall particle stands for a face within l0 of it: a box's outer layer
+ * lies at l0/2 on its own lattice; a cylinder sits on the case lattice, and
+ * a cap there can fall on a lattice plane, its first plane inside then at
+ * depth l0 exactly (a wall particle by the lattice-neighbour rule of
+ * scene_solids.c): l0 with a margin for the round-off of that depth. */
+static bool stands_for(double depth, double l0)
+{
+    return depth < l0 * (1 + 1e-6);
+}
+
+/* The area of face f of surface_faces: a box's face, the product of the
+ * other edges; a cylinder's side 2 pi r L, a cap pi r^2. */
+static double face_area(const mf_wall *w, int dim, int f)
+{
+    if (w->shape == MF_SOLID_CYLINDER)
+        return f == 0 ? 2 * M_PI * w->radius * 2 * w->half_length
+                      : M_PI * w->radius * w->radius;
+    double area = 1;
+    for (int a = 0; a < dim; a++)
+        if (a != f / 2)
+            area *= w->max[a] - w->min[a];
+    return area;
 }
 
 int mf_body_surface_prepare(mf_wall *w, const mf_particles *p, int f_wall_id, int index,
@@ -511,28 +605,27 @@ int mf_body_surface_prepare(mf_wall *w, const mf_particles *p, int f_wall_id, in
     for (size_t i = 0; i < p->n_owned; i++) {
         if (id[i] != index + 1 || p->kind[i] != MF_WALL)
             continue;
-        double xb[3], depth[6];
+        double xb[3], depth[6], normal[6][3];
         mf_wall_to_body(w, &p->pos[3 * i], xb);
         nround++;
-        face_depths(w, dim, xb, depth);
-        for (int f = 0; f < 2 * dim; f++)
-            count[f] += depth[f] < l0;
+        const int nf = surface_faces(w, dim, xb, depth, normal);
+        for (int f = 0; f < nf; f++)
+            count[f] += stands_for(depth[f], l0);
+        if (w->shape == MF_SOLID_MESH) /* its outer particles (no faces: count[0]) */
+            count[0] += stands_for(-mf_wall_body_distance(w, xb, normal[0]), l0);
     }
     /* the counts over every rank's owned particles (whole numbers: exact) */
     double counts[7] = {count[0], count[1], count[2], count[3], count[4], count[5], nround};
     mf_parallel_sum(par, counts, 7);
     memcpy(count, counts, sizeof count);
     nround = counts[6];
-    if (w->shape == MF_SOLID_BOX) {
-        for (int f = 0; f < 2 * dim; f++) {
-            double area = 1;
-            for (int a = 0; a < dim; a++)
-                if (a != f / 2)
-                    area *= w->max[a] - w->min[a];
+    const int nf = face_count(w, dim);
+    if (nf > 0) {
+        for (int f = 0; f < nf; f++) {
             if (count[f] == 0)
                 return MF_ERROR(MF_ERR_INPUT, "%s: rigid body '%s': no wall particle on a face: "
                                 "make it at least two particle spacings wide", w->where, w->name);
-            b->face_area[f] = area / count[f];
+            b->face_area[f] = face_area(w, dim, f) / count[f];
         }
     } else if (w->shape == MF_SOLID_SPHERE || (w->shape == MF_SOLID_CYLINDER && dim == 2)) {
         const double r = w->radius;
@@ -541,10 +634,20 @@ int mf_body_surface_prepare(mf_wall *w, const mf_particles *p, int f_wall_id, in
             return MF_ERROR(MF_ERR_INPUT, "%s: rigid body '%s' has no wall particle", w->where,
                             w->name);
         b->round_area = area / nround;
+    } else if (w->shape == MF_SOLID_MESH && w->mesh && dim == 3) {
+        /* the mesh's whole area over its outer particles, each with the
+         * normal at its nearest point (mf_body_surface) */
+        mf_trimesh_report r;
+        MF_CALL(mf_wall_mesh_report(w->mesh, &r));
+        if (count[0] == 0)
+            return MF_ERROR(MF_ERR_INPUT, "%s: rigid body '%s' has no wall particle within l0 "
+                            "of its surface", w->where, w->name);
+        b->round_area = r.area / count[0];
     } else {
         return MF_ERROR(MF_ERR_INPUT, "%s: rigid body '%s': the fluid's pressure on it is "
-                        "summed for boxes, disks and spheres only so far (a 3-D cylinder or a "
-                        "mesh is not yet)", w->where, w->name);
+                        "summed for boxes, cylinders, spheres and 3-D meshes only (a 2-D mesh "
+                        "body: use gradient corrected, whose pair reaction needs no surface)",
+                        w->where, w->name);
     }
     b->surface_ready = true;
     return 0;
@@ -559,14 +662,13 @@ int mf_body_surface(const mf_wall *w, const double x[3], double l0, double out_a
     mf_wall_to_body(w, x, xb);
     int n = 0;
     double nb[3] = {0, 0, 0}, db = 0;
-    if (w->shape == MF_SOLID_BOX) {
-        double depth[6];
-        face_depths(w, dim, xb, depth);
-        for (int f = 0; f < 2 * dim && n < 3; f++) {
-            if (!(depth[f] < l0))
+    double depth[6], normal[6][3];
+    const int nf = surface_faces(w, dim, xb, depth, normal);
+    if (nf > 0) {
+        for (int f = 0; f < nf && n < 3; f++) {
+            if (!stands_for(depth[f], l0))
                 continue;
-            memset(nb, 0, sizeof nb);
-            nb[f / 2] = f % 2 ? 1 : -1;
+            memcpy(nb, normal[f], sizeof nb);
             db = depth[f];
             mf_mat3_vec(w->state.R, nb, out_area[n]);
             for (int a = 0; a < 3; a++) {
@@ -576,6 +678,17 @@ int mf_body_surface(const mf_wall *w, const double x[3], double l0, double out_a
             n++;
         }
         return n;
+    }
+    if (w->shape == MF_SOLID_MESH) { /* depth -d along the normal into the fluid */
+        const double d = mf_wall_body_distance(w, xb, nb);
+        if (!stands_for(-d, l0))
+            return 0;
+        mf_mat3_vec(w->state.R, nb, out_area[0]);
+        for (int a = 0; a < 3; a++) {
+            out_shift[0][a] = -d * out_area[0][a];
+            out_area[0][a] *= b->round_area;
+        }
+        return 1;
     }
     double r2 = 0;
     for (int a = 0; a < dim; a++)

@@ -819,10 +819,16 @@ int mf_scene_mesh_wall(mf_scene_meshes *sm, mf_sim *sim, const char *name, const
     }
     free(keys);
     band_free(&b);
+    /* a rigid body keeps its surface: its mass properties (mf_body_create)
+     * and its distance for the contacts (body_contact.c) need it */
+    if (rc == 0 && solid.motion.kind == MF_MOTION_RIGID)
+        rc = mf_wall_mesh_create(&it->mesh, mode, out_sign, half, 4 * l0, sim->dim, &solid.mesh);
     if (rc == 0)
         rc = mf_scene_solid_add(sim, &solid, first);
-    if (rc != 0)
+    if (rc != 0) {
         mf_motion_free(&solid.motion);
+        mf_wall_mesh_destroy(solid.mesh); /* not taken over: NULL, or still ours */
+    }
     MF_CALL(rc);
     if (nwall == 0)
         warn(sm, it, "no wall particle was placed (is the surface outside the domain, or, in "

@@ -18,6 +18,10 @@ double mf_wall_body_distance(const mf_wall *w, const double xb[3], double nb[3])
 int mf_wall_mesh_create(const mf_trimesh *m, int side, int out_sign, double half, double cell,
                         int dim, struct mf_wall_mesh **out);
 void mf_wall_mesh_destroy(struct mf_wall_mesh *wm);
+/* Its triangles (body frame), and mf_trimesh_check's report on a copy of
+ * them (closed or not, open edges, signed volume). */
+const mf_trimesh *mf_wall_mesh_surface(const struct mf_wall_mesh *wm);
+int mf_wall_mesh_report(const struct mf_wall_mesh *wm, mf_trimesh_report *r);
 /* The cell index again with another cell size; its current cell size. */
 int mf_wall_mesh_index(struct mf_wall_mesh *wm, double cell);
 double mf_wall_mesh_cell(const struct mf_wall_mesh *wm);

@@ -457,3 +457,18 @@ int mf_wall_mesh_terms(const struct mf_wall_mesh *wm, const mf_wall_tables *t,
     terms[0] = tm;
     return 1;
 }
+
+const mf_trimesh *mf_wall_mesh_surface(const struct mf_wall_mesh *wm)
+{
+    return &wm->m;
+}
+
+int mf_wall_mesh_report(const struct mf_wall_mesh *wm, mf_trimesh_report *r)
+{
+    mf_trimesh copy; /* mf_trimesh_check may turn triangles: not the kept mesh's */
+    int rc = copy_mesh(&wm->m, &copy);
+    if (rc == 0)
+        rc = mf_trimesh_check(&copy, r);
+    mf_trimesh_free(&copy);
+    return rc;
+}

@@ -27,7 +27,7 @@ typedef struct motion_settings {
     const char *type, *interpolation;
     double origin[3], axis[3], velocity[3], amplitude[3];
     double omega, angle_amplitude, cycles;
-    double density, mass, inertia[3], g[3], restitution; /* rigid */
+    double density, mass, inertia[3], g[3], restitution, friction; /* rigid */
 } motion_settings;
 
 const mf_param mf_motion_params[] = {
@@ -68,6 +68,9 @@ const mf_param mf_motion_params[] = {
     {"restitution", MF_PARAM_SCALAR, "0", 0, 1, NULL, offsetof(motion_settings, restitution),
      "rigid: coefficient of restitution of its contact with walls, obstacles and other bodies "
      "(0: the approach stops, 1: it bounces back at the speed it came)"},
+    {"friction", MF_PARAM_SCALAR, "0", 0, 10, NULL, offsetof(motion_settings, friction),
+     "rigid: Coulomb's coefficient of friction of its contacts (the tangential impulse at most "
+     "friction times the normal one; two bodies: the mean; 0: none)"},
 };
 const size_t mf_motion_nparams = sizeof mf_motion_params / sizeof mf_motion_params[0];
 const mf_param_section mf_motion_sections[] = {
@@ -253,6 +256,7 @@ int mf_motion_read(const mf_dict *d, int dim, mf_motion *m)
     m->cycles = s.cycles;
     m->density = s.density;
     m->restitution = s.restitution;
+    m->friction = s.friction;
     m->mass = s.mass;
     m->origin_given = mf_dict_find(d, "origin") != NULL;
     for (int a = 0; a < 3; a++) {
