@@ -104,6 +104,9 @@ CATALOGUE = [
     ("unknown top-level key", D, [("append", SOLV, "MSPCoeffs { beta 0.9; }\n")], DRY),
     ("unknown coefficient", D, [("sub", SOLV, r"    beta .*", "    bta 0.97;")], DRY),
     ("beta out of range", D, [("sub", SOLV, r"    beta .*", "    beta 2;")], DRY),
+    ("wallPressureExtrapolated, gradient corrected", D,
+     [("sub", SOLV, r"    beta .*", "    beta 0.97; wallPressureExtrapolated yes; gradient corrected;")],
+     DRY),
     ("reLaplacian out of range", D, [("sub", SOLV, r"    reLaplacian .*", "    reLaplacian 50;")],
      DRY),
     ("unknown pressure solver", D, [("sub", SOLV, r"solver          PCG_BoomerAMG;", "solver PCG_AMG;")],
@@ -436,6 +439,8 @@ EXPECTED.update({
         "--> mpsflow FATAL ERROR: {case}/system/solverDict:36:1: unknown key 'MSPCoeffs' in '(top level)' (did you mean 'MPSCoeffs'?); valid keys: solver, pressure, viscosity, forces, FoamFile, MPSCoeffs, multiFluidCoeffs, MAFLCoeffs",
     'unknown coefficient':
         "--> mpsflow FATAL ERROR: {case}/system/solverDict:20:5: unknown key 'bta' in 'MPSCoeffs' (did you mean 'beta'?); valid keys: reNumberDensity, reGradient, reLaplacian, beta, relaxation, compressibility, clipNegativePressure, gradientPmin, wallPressureExtrapolated, scheme, source, densityFactor, gradient, laplacian, shifting, shiftCoefficient, shiftMax, surfaceDetection, asymmetry, retrySource, collision, collisionAfterCorrection, collisionDistance, restitution, reorderInterval, viscosity, periodicLength, periodicOrigin, wall",
+    'wallPressureExtrapolated, gradient corrected':
+        "--> mpsflow FATAL ERROR: {case}/system/solverDict:20:16: key 'wallPressureExtrapolated': it continues the walls' pressure for gradient paper (eq. 5) only; set it to no there",
     'beta out of range':
         "--> mpsflow FATAL ERROR: {case}/system/solverDict:20:5: key 'beta': 2 is out of range [0.5, 1] (free surface where n* < beta n0 (eq. 18))",
     'reLaplacian out of range':

@@ -417,6 +417,8 @@ int mps_global_rows(const mps_data *d, const mf_sim *sim, long *row, size_t nrow
  * (d->wall NULL). */
 /* An error naming where `wall` was set, with why (0 when s says particles). */
 int mps_wall_refuse(const mps_settings *s, const mf_dict *solver_dict, const char *why);
+/* file:line:col of key in the solver dictionary's Coeffs (into buf). */
+const char *mps_key_where(const mf_dict *sd, const char *key, char *buf, size_t len);
 /* The tables and work arrays (nothing with wall particles); refuses the
  * choices the terms do not cover. */
 int mps_wall_create(mps_data *d, mf_sim *sim, const mf_dict *solver_dict);

@@ -121,6 +121,27 @@ int mps_reserve(mps_data *d, size_t n)
     return 0;
 }
 
+/* wallPressureExtrapolated acts in the paper gradient's correction of one
+ * fluid with wall particles (mps_correction_phase, mps_wall_pressure.c):
+ * refused where it would be ignored (wall wallWeight: mps_wall_create). */
+static int refuse_wall_pressure(const mps_settings *s, const mps_scheme *sc, const mf_sim *sim,
+                                const mf_dict *solver_dict)
+{
+    if (!s->wall_pressure_extrapolated)
+        return 0;
+    const char *why = NULL;
+    if (sc->gradient != MPS_GRADIENT_PAPER)
+        why = "it continues the walls' pressure for gradient paper (eq. 5) only";
+    else if (sim->nfluids > 1)
+        why = "it continues the pressure with one fluid's density (not with several fluids)";
+    if (!why)
+        return 0;
+    char where[512];
+    return MF_ERROR(MF_ERR_INPUT, "%s: key 'wallPressureExtrapolated': %s; set it to no there",
+                    mps_key_where(solver_dict, "wallPressureExtrapolated", where, sizeof where),
+                    why);
+}
+
 int mps_create_data(const mps_settings *s, mf_sim *sim, const mf_dict *solver_dict,
                     mps_data **out)
 {
@@ -137,6 +158,7 @@ int mps_create_data(const mps_settings *s, mf_sim *sim, const mf_dict *solver_di
     *out = d;
     d->s = *s;
     MF_CALL(mps_scheme_resolve(s, sim->dim, &d->sc));
+    MF_CALL(refuse_wall_pressure(s, &d->sc, sim, solver_dict));
     d->s.collision = d->sc.collision;
     d->density_scale = 1.0;
     d->attempt_step = -1;

@@ -42,15 +42,16 @@ struct mps_wall {
     long collisions;   /* face collisions, all steps */
 };
 
-/* Where `wall` was set in the solver dictionary (any solver's Coeffs). */
-static const char *wall_key_where(const mf_dict *sd, char *buf, size_t len)
+/* Where an MPS key was set in the solver dictionary (any solver's Coeffs:
+ * the table is shared), or "system/solverDict" if nowhere. */
+const char *mps_key_where(const mf_dict *sd, const char *key, char *buf, size_t len)
 {
     snprintf(buf, len, "system/solverDict");
     for (size_t k = 0; sd && k < sd->n; k++) {
         const mf_entry *e = sd->entries[k];
         if (e->n != 1 || e->items[0]->kind != MF_VAL_DICT)
             continue;
-        const mf_entry *w = mf_dict_find(e->items[0]->dict, "wall");
+        const mf_entry *w = mf_dict_find(e->items[0]->dict, key);
         if (w)
             return mf_loc_str(w->loc, buf, len);
     }
@@ -64,7 +65,7 @@ int mps_wall_refuse(const mps_settings *s, const mf_dict *solver_dict, const cha
     char where[512];
     return MF_ERROR(MF_ERR_INPUT,
                     "%s: wall wallWeight: %s; use wall particles; (the default) there",
-                    wall_key_where(solver_dict, where, sizeof where), why);
+                    mps_key_where(solver_dict, "wall", where, sizeof where), why);
 }
 
 static int reserve(struct mps_wall *w, size_t n)
@@ -94,6 +95,8 @@ int mps_wall_create(mps_data *d, mf_sim *sim, const mf_dict *solver_dict)
         why = "particle shifting has no wall term yet (set shifting none;)";
     else if (d->visc)
         why = "the implicit viscosity has no wall term yet (set viscosity explicit;)";
+    else if (d->s.wall_pressure_extrapolated)
+        why = "wallPressureExtrapolated continues the pressure to wall particles (set it to no)";
     else if (sim->par)
         why = "not on several ranks yet (run it serially)";
     else if (mf_bodies_count(sim->walls) > 0)
