@@ -187,12 +187,6 @@ static void shift(mf_wall *w, int dim, const double s[3])
 #define CONTACT_SWEEPS 50
 #define CONTACT_PASSES 4
 
-/* One sweep over A's particles that overlap B at the first sweep (normal
- * holds B's normal there; target NaN: not a contact): the normal impulse at each
- * is set so that its approach v_n becomes the target -e v_n0 (v_n0 its
- * approach at the first sweep), its total lam[i] over the sweeps kept >= 0
- * (a contact pushes, never pulls: Catto's accumulated clamping). Returns
- * the largest change of an impulse, N s (2-D: per metre). */
 /* Coulomb friction at contact point x of A with B after its normal impulse
  * (Catto 2005: the tangential impulse that stops the sliding velocity v_t,
  * its total lt over the sweeps kept within the friction cone |lt| <= mu
@@ -239,6 +233,12 @@ static double friction(mf_wall *A, mf_wall *B, int dim, double dt, const double 
     return change;
 }
 
+/* One sweep over A's particles that overlap B at the first sweep (normal
+ * holds B's normal there; target NaN: not a contact): the normal impulse at each
+ * is set so that its approach v_n becomes the target -e v_n0 (v_n0 its
+ * approach at the first sweep), its total lam[i] over the sweeps kept >= 0
+ * (a contact pushes, never pulls: Catto's accumulated clamping). Returns
+ * the largest change of an impulse, N s (2-D: per metre). */
 static double sweep(mf_walls *ws, const body_points *p, size_t ka, size_t kb, double e,
                     double mu, double dt, bool first, double *lam, double *target,
                     double *normal, double *lt)
