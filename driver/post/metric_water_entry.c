@@ -235,7 +235,7 @@ static int against_reference(const entry_settings *s, const mf_metric_ctx *ctx, 
         *error = f.rms;
         snprintf(line, len,
                  "against %s (T = t sqrt(g/D), H = h/D): RMS of (h - h_ref)/D over %zu of %zu "
-                 "points: %.6g; largest %.4g at T = %.4g",
+                 "points: %.9g; largest %.4g at T = %.4g",
                  s->reference, f.used, nref, f.rms, f.worst, f.at);
         char comment[1600];
         snprintf(comment, sizeof comment,
