@@ -35,6 +35,7 @@ coarse() {
     mixingFluids) echo 0.02 ;;        # preview 0.01
     rayleighTaylor) echo 0.04 ;;      # preview 0.02
     waterAirDamBreak) echo 0.04 ;;    # preview 0.02
+    waterEntry) echo 0.011 ;;         # preview 0.0055 (100 s of one core)
     *) echo "" ;;
     esac
 }

@@ -1,15 +1,22 @@
 /* metric_water_entry.c: a 2-D circular cylinder's penetration into calm
- * water (tutorials/waterEntry) against the momentum theory of water entry.
+ * water (tutorials/waterEntry) against an experiment and against the
+ * momentum theory of water entry.
  *
  * The experiment this case copies, Greenhow & Lin (1983), "Nonlinear free
  * surface effects: experiments and theory", MIT Dept. of Ocean Engineering
  * report 83-19 (a half-buoyant cylinder, D = 0.11 m), gives its penetration
- * in figures only; no tabulated numbers were found. The reference is
- * therefore an analytic model: a body of mass m (per metre) and half-width
- * c(h) of its wetted section at penetration h (the depth of its lowest point
- * below the undisturbed surface) takes up the fluid's added mass
- * a(h) = rho pi c^2 / 2, the flat plate's of half-width c (von Karman 1929,
- * "The impact on seaplane floats during landing", NACA TN 321), and
+ * in figures; `reference` names a CSV in validation/ of T = t sqrt(g/D),
+ * H = h/D (tutorials/waterEntry: points digitised from Sun et al. 2018's
+ * replot, see the file). With it the error is the RMS over the reference's
+ * points with T > 0 that the run covers of (h - h_exp)/D, the run's h
+ * interpolated linearly in time; result_experiment.csv has both.
+ *
+ * The analytic model, reported in result.csv (and the error without a
+ * reference): a body of mass m (per metre) and half-width c(h) of its
+ * wetted section at penetration h (the depth of its lowest point below the
+ * undisturbed surface) takes up the fluid's added mass a(h) = rho pi c^2 / 2,
+ * the flat plate's of half-width c (von Karman 1929, "The impact on seaplane
+ * floats during landing", NACA TN 321), and
  *
  *   d/dt [(m + a(h)) dh/dt] = m g - rho g A(h)
  *
@@ -19,7 +26,7 @@
  * Wagner (1932) wetting correction, the water piled up beside the body,
  * doubles it for small h: c^2 = 4 R h, up to R^2. Both hold while the
  * section is widening (h <= R); beyond it c = R is kept, the deep limit of
- * a half-submerged cylinder's added mass. error = the RMS over the body's
+ * a half-submerged cylinder's added mass. The model's RMS is over the body's
  * rows with 0 < t <= endTime of (h - h_vonKarman) / D; result.csv has h,
  * both models and the fraction of rows between them.
  *
@@ -37,7 +44,7 @@
 #include "mf_report.h"
 
 typedef struct entry_settings {
-    const char *metric, *body;
+    const char *metric, *body, *reference;
     double radius, surface, rho, g, end;
 } entry_settings;
 
@@ -54,7 +61,10 @@ static const mf_param entry_params[] = {
      "the water's density, kg/m^3"},
     {"gravity", MF_PARAM_SCALAR, "9.81", 0, 1e9, NULL, offsetof(entry_settings, g), "g, m/s^2"},
     {"endTime", MF_PARAM_SCALAR, NULL, 1e-9, 1e9, NULL, offsetof(entry_settings, end),
-     "compare up to this time, s (the models hold while h <= R)"},
+     "compare with the models up to this time, s (they hold while h <= R)"},
+    {"reference", MF_PARAM_WORD, "", MF_NO_RANGE, NULL, offsetof(entry_settings, reference),
+     "CSV file T = t sqrt(g/D), H = h/D in validation/ (an experiment): the error is the RMS "
+     "of (h - h_ref)/D at its points; empty: against von Karman's model"},
 };
 #define NEP (sizeof entry_params / sizeof entry_params[0])
 
@@ -166,6 +176,98 @@ static void integrate(const model *md, double speed, const double *tq, size_t n,
     }
 }
 
+/* The run's h/D at the reference's times T (= t sqrt(g/D)): hrun[i], linear
+ * in time, NAN where the run does not reach T or T <= 0 (the contact, h = 0
+ * by construction). *rms, *worst (the largest |h - h_ref|/D) and *at (its
+ * T) over the *used points compared. */
+typedef struct ref_fit {
+    double rms, worst, at;
+    size_t used;
+} ref_fit;
+
+static ref_fit fit_reference(const double *T, const double *H, size_t nref, const double *t,
+                             const double *h, size_t n, double tscale, double D, double *hrun)
+{
+    ref_fit f = {NAN, 0, NAN, 0};
+    double sum = 0;
+    for (size_t i = 0; i < nref; i++) {
+        hrun[i] = T[i] > 0 ? mf_interp(t, h, n, T[i] / tscale) / D : NAN;
+        if (isnan(hrun[i]))
+            continue;
+        const double d = hrun[i] - H[i];
+        sum += d * d;
+        f.used++;
+        if (fabs(d) > f.worst) {
+            f.worst = fabs(d);
+            f.at = T[i];
+        }
+    }
+    if (f.used)
+        f.rms = sqrt(sum / (double)f.used);
+    return f;
+}
+
+/* The run against validation/<reference>: result_experiment.csv/.png and a
+ * line of the summary; *error = the fit's RMS. */
+static int against_reference(const entry_settings *s, const mf_metric_ctx *ctx, const double *t,
+                             const double *h, size_t n, double *error, char *line, size_t len)
+{
+    char path[4400];
+    snprintf(path, sizeof path, "%s/validation/%s", ctx->case_dir, s->reference);
+    double *T = NULL, *H = NULL;
+    size_t nref = 0;
+    MF_CALL(mf_read_csv2(path, &T, &H, &nref));
+    const double D = 2 * s->radius, tscale = sqrt(s->g / D);
+    int rc = 0;
+    double *hrun = malloc((nref + 1) * sizeof *hrun), *Trun = malloc(n * sizeof *Trun),
+           *Hrun = malloc(n * sizeof *Hrun);
+    if (!hrun || !Trun || !Hrun)
+        rc = MF_ERROR(MF_ERR_MEMORY, "out of memory");
+    ref_fit f = {NAN, 0, NAN, 0};
+    if (rc == 0) {
+        f = fit_reference(T, H, nref, t, h, n, tscale, D, hrun);
+        if (f.used == 0)
+            rc = MF_ERROR(MF_ERR_INPUT,
+                          "%s: the run (to t = %g s, T = %g) covers none of its points with T > 0",
+                          path, t[n - 1], t[n - 1] * tscale);
+    }
+    if (rc == 0) {
+        *error = f.rms;
+        snprintf(line, len,
+                 "against %s (T = t sqrt(g/D), H = h/D): RMS of (h - h_ref)/D over %zu of %zu "
+                 "points: %.9g; largest %.4g at T = %.4g",
+                 s->reference, f.used, nref, f.rms, f.worst, f.at);
+        char comment[1600];
+        snprintf(comment, sizeof comment,
+                 "water entry of '%s' against %s: the run's H = h/D at the reference's T "
+                 "(linear in time; nan where the run does not reach T, and at T = 0)\n%s",
+                 s->body, s->reference, line);
+        snprintf(path, sizeof path, "%s/result_experiment.csv", ctx->out_dir);
+        const double *const cols[3] = {T, H, hrun};
+        rc = mf_report_csv(path, comment, "T,H_reference,H_run", 3, cols, nref);
+    }
+    if (rc == 0) {
+        for (size_t k = 0; k < n; k++) {
+            Trun[k] = t[k] * tscale;
+            Hrun[k] = h[k] / D;
+        }
+        snprintf(path, sizeof path, "%s/result_experiment.png", ctx->out_dir);
+        char title[256];
+        snprintf(title, sizeof title, "Water entry: penetration against %s (RMS %.3g)",
+                 s->reference, f.rms);
+        mf_plot plot = {title, "T = t (g/D)^{1/2}", "H = h/D", false, false, NULL};
+        mf_series series[2] = {{"mpsflow", Trun, Hrun, n, "lines", NULL},
+                               {s->reference, T, H, nref, "points", NULL}};
+        rc = mf_report_plot(path, &plot, series, 2);
+    }
+    free(hrun);
+    free(Trun);
+    free(Hrun);
+    free(T);
+    free(H);
+    return rc;
+}
+
 static int evaluate(const void *settings, const mf_metric_ctx *ctx, double *error)
 {
     const entry_settings s = *(const entry_settings *)settings;
@@ -181,14 +283,15 @@ static int evaluate(const void *settings, const mf_metric_ctx *ctx, double *erro
     size_t m = 0; /* rows with t0 < t <= endTime, t from the first row */
     const double t0 = n ? t[0] : 0;
     for (size_t k = 0; rc == 0 && k < n; k++) {
-        if (t[k] - t0 > s.end * (1 + 1e-12))
-            break;
-        t[m] = t[k] - t0;
-        h[m] = s.surface + s.radius - y[k];
-        m++;
+        t[k] -= t0;
+        h[k] = s.surface + s.radius - y[k];
+        if (t[k] <= s.end * (1 + 1e-12))
+            m = k + 1;
     }
     if (rc == 0 && m < 3)
         rc = MF_ERROR(MF_ERR_INPUT, "%s: fewer than three rows up to endTime %g s", path, s.end);
+    double model_rms = NAN;
+    char ref_line[600] = "";
     if (rc == 0) {
         const model vk = {s.radius, mass, s.rho, s.g, false}, wg = {s.radius, mass, s.rho, s.g, true};
         integrate(&vk, -v0, t, m, hk);
@@ -202,23 +305,29 @@ static int evaluate(const void *settings, const mf_metric_ctx *ctx, double *erro
             rows++;
             between += h[k] >= fmin(hk[k], hw[k]) && h[k] <= fmax(hk[k], hw[k]);
         }
-        *error = sqrt(sum / (double)rows);
-        char comment[1400];
+        model_rms = sqrt(sum / (double)rows);
+        *error = model_rms;
+        if (s.reference[0])
+            rc = against_reference(&s, ctx, t, h, n, error, ref_line, sizeof ref_line);
+        char comment[2200];
         snprintf(comment, sizeof comment,
                  "water entry of '%s': R = %g m, mass %.6g kg/m, entry speed %.6g m/s, level %g m\n"
                  "h = (level + R) - y_c against the momentum theory, added mass rho pi c^2/2: "
                  "von Karman (c^2 = 2Rh - h^2) and Wagner (c^2 = 4Rh), c = R beyond h = R\n"
                  "RMS of (h - h_vonKarman)/D over %zu rows to t = %g s: %.6g; at t = %.6g s h = "
-                 "%.6g m, von Karman %.6g m, Wagner %.6g m; %zu of %zu rows between the two",
-                 s.body, s.radius, mass, -v0, s.surface, rows, t[m - 1], *error, t[m - 1],
-                 h[m - 1], hk[m - 1], hw[m - 1], between, rows);
+                 "%.6g m, von Karman %.6g m, Wagner %.6g m; %zu of %zu rows between the two%s%s",
+                 s.body, s.radius, mass, -v0, s.surface, rows, t[m - 1], model_rms, t[m - 1],
+                 h[m - 1], hk[m - 1], hw[m - 1], between, rows, ref_line[0] ? "\n" : "",
+                 ref_line);
         snprintf(path, sizeof path, "%s/result.csv", ctx->out_dir);
         const double *const cols[4] = {t, h, hk, hw};
-        rc = mf_report_csv(path, comment, "t,h,h_vonKarman,h_Wagner", 4, cols, m);
+        if (rc == 0)
+            rc = mf_report_csv(path, comment, "t,h,h_vonKarman,h_Wagner", 4, cols, m);
         if (rc == 0) {
             snprintf(path, sizeof path, "%s/result.png", ctx->out_dir);
             char title[256];
-            snprintf(title, sizeof title, "Water entry: penetration (RMS error %.3g D)", *error);
+            snprintf(title, sizeof title, "Water entry: penetration (RMS against von Karman %.3g D)",
+                     model_rms);
             mf_plot plot = {title, "t, s", "penetration h, m", false, false, NULL};
             mf_series series[3] = {{"mpsflow", t, h, m, "linespoints", NULL},
                                    {"von Karman", t, hk, m, "lines", NULL},
@@ -236,8 +345,8 @@ static int evaluate(const void *settings, const mf_metric_ctx *ctx, double *erro
 
 const mf_metric_ops mf_metric_water_entry = {
     {MF_ABI_VERSION, MF_KIND_METRIC, "waterEntryDepth",
-     "a cylinder's penetration into water against the momentum theory with von Karman's added "
-     "mass (Wagner's in the report)",
+     "a cylinder's penetration into water against an experiment's (reference) or the momentum "
+     "theory with von Karman's added mass (Wagner's in the report)",
      entry_params, NEP, sizeof(entry_settings)},
     evaluate,
     NULL,
