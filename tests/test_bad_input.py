@@ -107,6 +107,14 @@ CATALOGUE = [
     ("wallPressureExtrapolated, gradient corrected", D,
      [("sub", SOLV, r"    beta .*", "    beta 0.97; wallPressureExtrapolated yes; gradient corrected;")],
      DRY),
+    ("gradientWeight, gradient leastSquares", D,
+     [("sub", SOLV, r"    beta .*", "    beta 0.97; gradientWeight wendland; gradient leastSquares;")],
+     DRY),
+    ("gradientWeight, wall wallWeight", D,
+     [("sub", SOLV, r"    beta .*", "    beta 0.97; gradientWeight wendland; wall wallWeight; source mixed;")],
+     DRY),
+    ("gradientWeight unknown", D, [("sub", SOLV, r"    beta .*", "    beta 0.97; gradientWeight cubic;")],
+     DRY),
     ("reLaplacian out of range", D, [("sub", SOLV, r"    reLaplacian .*", "    reLaplacian 50;")],
      DRY),
     ("unknown pressure solver", D, [("sub", SOLV, r"solver          PCG_BoomerAMG;", "solver PCG_AMG;")],
@@ -438,9 +446,15 @@ EXPECTED.update({
     'unknown top-level key':
         "--> mpsflow FATAL ERROR: {case}/system/solverDict:36:1: unknown key 'MSPCoeffs' in '(top level)' (did you mean 'MPSCoeffs'?); valid keys: solver, pressure, viscosity, forces, FoamFile, MPSCoeffs, multiFluidCoeffs, MAFLCoeffs",
     'unknown coefficient':
-        "--> mpsflow FATAL ERROR: {case}/system/solverDict:20:5: unknown key 'bta' in 'MPSCoeffs' (did you mean 'beta'?); valid keys: reNumberDensity, reGradient, reLaplacian, beta, relaxation, compressibility, clipNegativePressure, gradientPmin, wallPressureExtrapolated, scheme, source, densityFactor, gradient, laplacian, shifting, shiftCoefficient, shiftMax, surfaceDetection, asymmetry, retrySource, collision, collisionAfterCorrection, collisionDistance, restitution, reorderInterval, viscosity, periodicLength, periodicOrigin, wall",
+        "--> mpsflow FATAL ERROR: {case}/system/solverDict:20:5: unknown key 'bta' in 'MPSCoeffs' (did you mean 'beta'?); valid keys: reNumberDensity, reGradient, reLaplacian, beta, relaxation, compressibility, clipNegativePressure, gradientPmin, gradientWeight, wallPressureExtrapolated, scheme, source, densityFactor, gradient, laplacian, shifting, shiftCoefficient, shiftMax, surfaceDetection, asymmetry, retrySource, collision, collisionAfterCorrection, collisionDistance, restitution, reorderInterval, viscosity, periodicLength, periodicOrigin, wall",
     'wallPressureExtrapolated, gradient corrected':
         "--> mpsflow FATAL ERROR: {case}/system/solverDict:20:16: key 'wallPressureExtrapolated': it continues the walls' pressure for gradient paper (eq. 5) only; set it to no there",
+    'gradientWeight, gradient leastSquares':
+        "--> mpsflow FATAL ERROR: {case}/system/solverDict:20:16: key 'gradientWeight': it weights eq. 5's sum (gradient paper or corrected), not the least-squares gradient; set it to paper there",
+    'gradientWeight, wall wallWeight':
+        "--> mpsflow FATAL ERROR: {case}/system/solverDict:20:41: wall wallWeight: the wall tables integrate the paper's weight (set gradientWeight paper;); use wall particles; (the default) there",
+    'gradientWeight unknown':
+        "--> mpsflow FATAL ERROR: {case}/system/solverDict:20:16: key 'gradientWeight': unknown choice 'cubic'; valid: paper, wendland, wendlandW",
     'beta out of range':
         "--> mpsflow FATAL ERROR: {case}/system/solverDict:20:5: key 'beta': 2 is out of range [0.5, 1] (free surface where n* < beta n0 (eq. 18))",
     'reLaplacian out of range':

@@ -46,12 +46,13 @@ typedef struct errors {
 } errors;
 
 /* Relative errors at the particles farther than re from the lattice edge. */
-static errors measure(int dim, int m, double re_l0, double jitter, bool print)
+static errors measure(int dim, int m, double re_l0, double jitter, bool print, int shape)
 {
     const double l0 = 0.01;
     mf_particles *p = lattice(dim, m, l0, jitter);
     mf_kernel k;
     CHECK_OK(mf_kernel_init(&k, dim, l0, re_l0 * l0));
+    CHECK_OK(mf_kernel_set_gradient_weight(&k, shape)); /* eq. 5 only */
     mf_grid g;
     mf_nlist nl;
     mf_grid_init(&g);
@@ -99,9 +100,9 @@ static errors measure(int dim, int m, double re_l0, double jitter, bool print)
     }
     CHECK(counted > 0);
     if (print)
-        printf("%d-D re = %.1f l0, jitter %.3f l0, %zu interior particles: max relative error "
-               "n %.2e, grad %.2e, div %.2e, lap %.2e\n",
-               dim, re_l0, jitter, counted, e.nd, e.grad, e.div, e.lap);
+        printf("%d-D re = %.1f l0, jitter %.3f l0, gradient weight %d, %zu interior particles: "
+               "max relative error n %.2e, grad %.2e, div %.2e, lap %.2e\n",
+               dim, re_l0, jitter, shape, counted, e.nd, e.grad, e.div, e.lap);
     free(f); free(q); free(u); free(nd); free(grad); free(div); free(lap);
     mf_grid_free(&g);
     mf_nlist_free(&nl);
@@ -130,12 +131,51 @@ static void test_kernel_constants(void)
 static void test_exact_on_lattice(void)
 {
     const double radii[] = {2.1, 3.1, 4.0};
-    for (int r = 0; r < 3; r++) {
-        errors e2 = measure(2, 24, radii[r], 0.0, true);
-        CHECK(e2.nd < 1e-12 && e2.grad < 1e-10 && e2.div < 1e-10 && e2.lap < 1e-10);
+    /* eq. 5 is exact for a linear field with any gradient weight scaled by
+     * its own lattice sum n0_g (mf_kernel_set_gradient_weight) */
+    const int shapes[] = {MF_GRAD_WEIGHT_PAPER, MF_GRAD_WEIGHT_WENDLAND, MF_GRAD_WEIGHT_WENDLAND_W};
+    for (int w = 0; w < 3; w++) {
+        for (int r = 0; r < 3; r++) {
+            errors e2 = measure(2, 24, radii[r], 0.0, true, shapes[w]);
+            CHECK(e2.nd < 1e-12 && e2.grad < 1e-10 && e2.div < 1e-10 && e2.lap < 1e-10);
+        }
+        errors e3 = measure(3, 12, 2.1, 0.0, true, shapes[w]);
+        CHECK(e3.nd < 1e-12 && e3.grad < 1e-10 && e3.div < 1e-10 && e3.lap < 1e-10);
     }
-    errors e3 = measure(3, 12, 2.1, 0.0, true);
-    CHECK(e3.nd < 1e-12 && e3.grad < 1e-10 && e3.div < 1e-10 && e3.lap < 1e-10);
+}
+
+/* The gradient weights (mf_kernel.h): the paper's n0_grad is n0; the
+ * Wendland C2 -r W'(r) = 20 q^2 (1 - q)^3 and W = (1 - q)^4 (1 + 4q) summed
+ * by hand over the 12 neighbours within 2.1 l0 (4 at 1, 4 at sqrt 2, 4 at
+ * 2). The pair force of the wendland weight, w_g / r, is -W' up to the
+ * constant: it vanishes at r -> 0 and at re, where the paper's diverges. */
+static void test_gradient_weights(void)
+{
+    mf_kernel k;
+    CHECK_OK(mf_kernel_init(&k, 2, 1.0, 2.1));
+    CHECK(k.grad_weight == MF_GRAD_WEIGHT_PAPER && k.n0_grad == k.n0);
+    const double r[3] = {1.0, sqrt(2.0), 2.0};
+    double drw = 0, ww = 0;
+    for (int s = 0; s < 3; s++) {
+        double q = r[s] / 2.1;
+        drw += 4 * 20 * q * q * pow(1 - q, 3);
+        ww += 4 * pow(1 - q, 4) * (1 + 4 * q);
+    }
+    CHECK_OK(mf_kernel_set_gradient_weight(&k, MF_GRAD_WEIGHT_WENDLAND));
+    CHECK_NEAR(k.n0_grad, drw, 1e-12);
+    CHECK_OK(mf_kernel_set_gradient_weight(&k, MF_GRAD_WEIGHT_WENDLAND_W));
+    CHECK_NEAR(k.n0_grad, ww, 1e-12);
+    CHECK_NEAR(k.n0, 4 * (2.1 - 1) + 4 * (2.1 / sqrt(2) - 1) + 4 * (2.1 / 2 - 1), 1e-12);
+    /* -r W'(r) from W by a central difference */
+    const double q = 0.37, h = 1e-6;
+    double dW = (mf_weight_wendland((q + h) * 2.1, 2.1) - mf_weight_wendland((q - h) * 2.1, 2.1)) /
+                (2 * h * 2.1);
+    CHECK_NEAR(mf_weight_wendland_drw(q * 2.1, 2.1), -q * 2.1 * dW, 1e-8);
+    CHECK(mf_weight_gradient(0.0, 2.1, MF_GRAD_WEIGHT_WENDLAND) == 0.0);
+    CHECK(mf_weight_gradient(2.1, 2.1, MF_GRAD_WEIGHT_WENDLAND) == 0.0);
+    CHECK(mf_weight_gradient(1.3, 2.1, MF_GRAD_WEIGHT_PAPER) == mf_weight(1.3, 2.1));
+    CHECK(mf_kernel_set_gradient_weight(&k, 7) == MF_ERR_INPUT);
+    mf_error_clear();
 }
 
 static void test_jittered_lattice(void)
@@ -143,11 +183,11 @@ static void test_jittered_lattice(void)
     /* The error is driven by the irregularity: halving the jitter must
      * roughly halve it (first order), and it stays moderate. */
     rng = 7;
-    errors big = measure(2, 30, 3.1, 0.10, true);
+    errors big = measure(2, 30, 3.1, 0.10, true, MF_GRAD_WEIGHT_PAPER);
     rng = 7;
-    errors small = measure(2, 30, 3.1, 0.05, true);
+    errors small = measure(2, 30, 3.1, 0.05, true, MF_GRAD_WEIGHT_PAPER);
     rng = 7;
-    errors tiny = measure(2, 30, 3.1, 0.025, true);
+    errors tiny = measure(2, 30, 3.1, 0.025, true, MF_GRAD_WEIGHT_PAPER);
     CHECK(small.grad < 0.7 * big.grad && tiny.grad < 0.7 * small.grad);
     CHECK(small.div < 0.7 * big.div && tiny.div < 0.7 * small.div);
     CHECK(small.nd < 0.7 * big.nd && tiny.nd < 0.7 * small.nd);
@@ -191,6 +231,7 @@ int main(void)
 {
     test_kernel_constants();
     test_exact_on_lattice();
+    test_gradient_weights();
     test_jittered_lattice();
     test_free_surface();
     return mf_test_summary("operators");

@@ -16,6 +16,50 @@ static inline double mf_weight(double r, double re)
     return (r > 0.0 && r < re) ? re / r - 1.0 : 0.0;
 }
 
+/* The pressure gradient's own weight (eq. 5's w, apart from the number
+ * density's eq. 3). Eq. 5 is exact for a linear field on the full lattice
+ * with any weight w_g if the sum is scaled by d / n0_g, n0_g the lattice
+ * sum of w_g (mf_kernel.n0_grad), so the weight's shape is free. The choice
+ * matters for the lattice's stability under eq. 5's pair repulsion (f_j -
+ * f^_i) w_g r_ij / r^2: Dehnen & Aly (2012, MNRAS 425, 1068-1082) find that
+ * SPH pair forces of magnitude -W'(r) keep particle lattices stable when
+ * the kernel's Fourier transform is positive, as the Wendland functions'
+ * is. MF_GRAD_WEIGHT_WENDLAND makes eq. 5's pair force that: w_g = -r
+ * W'(r) for the Wendland C2 kernel W(q) = (1 - q)^4 (1 + 4q), q = r/re
+ * (Wendland 1995; Dehnen & Aly's Table 1, the same form in 2-D and 3-D),
+ * i.e. w_g = 20 q^2 (1 - q)^3 (its constant cancels in d / n0_g).
+ * MF_GRAD_WEIGHT_WENDLAND_W takes W itself as w_g. */
+typedef enum {
+    MF_GRAD_WEIGHT_PAPER = 0,     /* w = re/r - 1 (eq. 3): the paper's */
+    MF_GRAD_WEIGHT_WENDLAND = 1,  /* -r W'(r) of Wendland C2 */
+    MF_GRAD_WEIGHT_WENDLAND_W = 2 /* Wendland C2's W(r) */
+} mf_grad_weight;
+
+static inline double mf_weight_wendland_drw(double r, double re)
+{
+    if (!(r > 0.0 && r < re))
+        return 0.0;
+    const double q = r / re, u = 1.0 - q;
+    return 20.0 * q * q * u * u * u;
+}
+
+static inline double mf_weight_wendland(double r, double re)
+{
+    if (!(r > 0.0 && r < re))
+        return 0.0;
+    const double q = r / re, u = 1.0 - q;
+    return u * u * u * u * (1.0 + 4.0 * q);
+}
+
+/* The gradient's weight of one pair (mf_weight for the paper's, the same
+ * operations: eq. 5 stays bit for bit). */
+static inline double mf_weight_gradient(double r, double re, int shape)
+{
+    return shape == MF_GRAD_WEIGHT_WENDLAND     ? mf_weight_wendland_drw(r, re)
+           : shape == MF_GRAD_WEIGHT_WENDLAND_W ? mf_weight_wendland(r, re)
+                                                : mf_weight(r, re);
+}
+
 /* Pair averages (eq. 27 with unlike neighbours; the variable-density PPE).
  * Density: 1/rho_ij = 1/rho_bar_ij with rho_bar the arithmetic mean
  * (rho_i + rho_j)/2 (the default: the series coefficient of a flux across
@@ -100,11 +144,21 @@ typedef struct mf_kernel {
      * of a half lattice (the neighbours with y <= 0): the scale of the
      * neighbour-asymmetry test of free-surface detection. */
     double asym_flat;
+    /* The pressure gradient's weight (mf_grad_weight, mf_weight_gradient)
+     * and its lattice sum n0_g: eq. 5 is scaled by d / n0_grad. With the
+     * paper's weight n0_grad == n0. Only eq. 5 (mf_gradient_ex) reads
+     * them; the divergence, the shifting's gradients and the wall terms
+     * keep w = re/r - 1 and n0. */
+    int grad_weight;
+    double n0_grad;
 } mf_kernel;
 
 /* n0, lambda, hl_coef and asym_flat from the ideal full lattice (2-D square,
  * 3-D cubic) of spacing l0, every lattice point within re of the origin. */
 int mf_kernel_init(mf_kernel *k, int dim, double l0, double re);
+/* The pressure gradient's weight shape (mf_grad_weight) and its n0_grad,
+ * summed over the same ideal lattice as n0 (mf_kernel_init first). */
+int mf_kernel_set_gradient_weight(mf_kernel *k, int shape);
 
 #pragma GCC visibility pop
 #endif

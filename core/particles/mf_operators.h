@@ -24,7 +24,9 @@
 void mf_number_density(const mf_pairs *v, const uint8_t *imask, const uint8_t *jmask,
                        double *n);
 
-/* eq. 5: <grad f>_i = d/n0 sum_j c_ij (f_j - f^_i) r_ij/|r_ij|^2 w(|r_ij|). */
+/* eq. 5: <grad f>_i = d/n0 sum_j c_ij (f_j - f^_i) r_ij/|r_ij|^2 w(|r_ij|),
+ * with the kernel's gradient weight as w and its n0_grad as n0
+ * (mf_kernel_set_gradient_weight; the paper's w and n0 by default). */
 typedef struct mf_gradient_opts {
     const double *f;
     /* f^_i: f_i, or with use_min the minimum of f over i and its (jmask)

@@ -43,7 +43,8 @@ typedef struct {
     const mf_pairs *v;
     const mf_gradient_opts *o;
     const uint8_t *jmask;
-    double coef; /* d / n0 */
+    double coef; /* d / n0_g */
+    int weight;  /* mf_grad_weight */
     double *out;
 } grad_ctx;
 
@@ -79,7 +80,8 @@ static inline bool grad_pair(void *acc, const void *ctx, const mf_pair *pr, int 
                        : mode == COEF_CONSTANT ? o->coef
                                                : 1.0;
     const double s =
-        mf_gradient_term(o->f[pr->j] - a->fhat, cij, mf_weight(pr->len, c->v->radius), pr->len);
+        mf_gradient_term(o->f[pr->j] - a->fhat, cij,
+                         mf_weight_gradient(pr->len, c->v->radius, c->weight), pr->len);
     a->g[0] += s * pr->r[0];
     a->g[1] += s * pr->r[1];
     a->g[2] += s * pr->r[2];
@@ -117,7 +119,8 @@ static inline bool cgrad_pair(void *acc, const void *ctx, const mf_pair *pr, int
                        : mode == COEF_CONSTANT ? o->coef
                                                : 1.0;
     const double df = (o->f[pr->i] + o->f[pr->j]) - (o->fhat[pr->i] + o->fhat[pr->j]);
-    const double s = mf_gradient_term(df, cij, mf_weight(pr->len, c->v->radius), pr->len);
+    const double s =
+        mf_gradient_term(df, cij, mf_weight_gradient(pr->len, c->v->radius, c->weight), pr->len);
     a->g[0] += s * pr->r[0];
     a->g[1] += s * pr->r[1];
     a->g[2] += s * pr->r[2];
@@ -183,7 +186,7 @@ static void grad_row_rho(const void *ctx, size_t i) { grad_row(ctx, i, COEF_RHO)
 void mf_gradient_ex(const mf_pairs *v, const mf_kernel *k, const mf_gradient_opts *o,
                     const uint8_t *imask, const uint8_t *jmask, double *out)
 {
-    const grad_ctx c = {v, o, jmask, k->dim / k->n0, out};
+    const grad_ctx c = {v, o, jmask, k->dim / k->n0_grad, k->grad_weight, out};
     if (o->fhat) { /* corrected (CMPS) */
         if (o->rho)
             mf_pairs_each(v, imask, cgrad_row_rho, &c);

@@ -33,6 +33,7 @@ typedef struct mps_settings {
     double compressibility;   /* 1/Pa; adds rho c / dt^2 to the diagonal (0: off) */
     bool clip_negative_pressure;
     bool gradient_pmin;       /* eq. 5 with p_min (Koshizuka et al. 1998) */
+    const char *gradient_weight; /* eq. 5's weight: paper | wendland | wendlandW (mf_grad_weight) */
     bool wall_pressure_extrapolated; /* the gradient reads the walls' p from the fluid's (mps_wall_pressure.c) */
     /* The scheme (mps_scheme.c): a named set of the five choices below,
      * each of which a case may set apart ("scheme": the scheme's). */
@@ -177,10 +178,11 @@ typedef struct mps_data {
 enum { MPS_FLAG_SURFACE = 1 }; /* bits of the Flags field */
 
 extern const mf_solver_ops mf_solver_MPS;
-#define MPS_NPARAMS 29 /* checked against the table in mps_params.c */
+#define MPS_NPARAMS 30 /* checked against the table in mps_params.c */
 extern const mf_param mps_params[MPS_NPARAMS];
 extern const char *const mps_viscosity_choices[]; /* explicit, implicit */
 extern const char *const mps_wall_choices[];      /* particles, wallWeight */
+extern const char *const mps_gradient_weight_choices[]; /* paper, wendland, wendlandW */
 /* mps_scheme.c */
 extern const char *const mps_scheme_choices[], *const mps_source_choices[],
     *const mps_gradient_choices[], *const mps_laplacian_choices[], *const mps_shifting_choices[],
@@ -215,6 +217,11 @@ extern const char *const mps_scheme_choices[], *const mps_source_choices[],
     {"gradientPmin", MF_PARAM_BOOL, "yes", MF_NO_RANGE, NULL,                                   \
      OFF(gradient_pmin),                                                                        \
      "pressure gradient with p_min of the neighbourhood (eq. 5 note)"},                         \
+    {"gradientWeight", MF_PARAM_WORD, "paper", MF_NO_RANGE, mps_gradient_weight_choices,        \
+     OFF(gradient_weight),                                                                      \
+     "weight of the pressure gradient's sum (eq. 5), scaled by its own lattice n0: paper "      \
+     "(re/r - 1), wendland (-r W'(r) of the Wendland C2 kernel: the pair force -W', Dehnen & "  \
+     "Aly 2012), wendlandW (W itself); not with wall wallWeight or gradient leastSquares"},     \
     {"wallPressureExtrapolated", MF_PARAM_BOOL, "no", MF_NO_RANGE, NULL,                        \
      OFF(wall_pressure_extrapolated),                                                           \
      "the pressure gradient takes the wall particles' pressure from their fluid neighbours' "   \

@@ -142,6 +142,30 @@ static int refuse_wall_pressure(const mps_settings *s, const mps_scheme *sc, con
                     why);
 }
 
+/* gradientWeight: eq. 5's weight (mf_kernel.h, mf_grad_weight) on the
+ * gradient's kernel, its n0_g from the same ideal lattice as n0. Refused
+ * where the gradient is not eq. 5's sum (leastSquares: LSMPS has its own
+ * weight; its fallback would take this one) and with wall wallWeight
+ * (mps_wall_create: its tables integrate the paper's w). */
+static int gradient_weight(const mps_settings *s, const mps_scheme *sc,
+                           const mf_dict *solver_dict, mf_kernel *k)
+{
+    int shape = MF_GRAD_WEIGHT_PAPER;
+    for (int c = 0; s->gradient_weight && mps_gradient_weight_choices[c]; c++)
+        if (strcmp(s->gradient_weight, mps_gradient_weight_choices[c]) == 0)
+            shape = c;
+    if (shape == MF_GRAD_WEIGHT_PAPER)
+        return 0;
+    if (sc->gradient == MPS_GRADIENT_LEAST_SQUARES) {
+        char where[512];
+        return MF_ERROR(MF_ERR_INPUT,
+                        "%s: key 'gradientWeight': it weights eq. 5's sum (gradient paper or "
+                        "corrected), not the least-squares gradient; set it to paper there",
+                        mps_key_where(solver_dict, "gradientWeight", where, sizeof where));
+    }
+    return mf_kernel_set_gradient_weight(k, shape);
+}
+
 int mps_create_data(const mps_settings *s, mf_sim *sim, const mf_dict *solver_dict,
                     mps_data **out)
 {
@@ -164,6 +188,7 @@ int mps_create_data(const mps_settings *s, mf_sim *sim, const mf_dict *solver_di
     d->attempt_step = -1;
     MF_CALL(mf_kernel_init(&d->k_nd, sim->dim, sim->l0, s->re_number_density * sim->l0));
     MF_CALL(mf_kernel_init(&d->k_grad, sim->dim, sim->l0, s->re_gradient * sim->l0));
+    MF_CALL(gradient_weight(s, &d->sc, solver_dict, &d->k_grad));
     MF_CALL(mf_kernel_init(&d->k_lap, sim->dim, sim->l0, s->re_laplacian * sim->l0));
     MF_CALL(request_neighbours(d, sim));
     sim->n0 = d->k_nd.n0; /* the NumberDensity field's reference, for the run's watch */
@@ -193,6 +218,9 @@ int mps_create_data(const mps_settings *s, mf_sim *sim, const mf_dict *solver_di
         mf_log_printf(sim->log, MF_LOG_NORMAL,
                       "MPS kernel (%s): re = %g l0, n0 = %.6g, lambda = %.6g l0^2\n", names[k],
                       ks[k]->re / sim->l0, ks[k]->n0, ks[k]->lambda / (sim->l0 * sim->l0));
+    if (d->k_grad.grad_weight != MF_GRAD_WEIGHT_PAPER)
+        mf_log_printf(sim->log, MF_LOG_NORMAL, "MPS gradient weight: %s, n0_g = %.6g\n",
+                      s->gradient_weight, d->k_grad.n0_grad);
     mf_log_printf(sim->log, MF_LOG_NORMAL, "Pressure solver: %s\n", d->pressure.info->name);
     mps_scheme_log(d, sim->log);
     return 0;

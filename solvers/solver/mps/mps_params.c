@@ -9,3 +9,5 @@ const mf_param mps_params[MPS_NPARAMS] = {MPS_PARAM_ENTRIES(MPS_OFFSET, "robust"
  * the registry refuses at start-up. */
 
 const char *const mps_viscosity_choices[] = {"explicit", "implicit", NULL};
+/* gradientWeight, in mf_grad_weight order (mps_module.c: gradient_weight). */
+const char *const mps_gradient_weight_choices[] = {"paper", "wendland", "wendlandW", NULL};
