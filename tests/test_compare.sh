@@ -35,6 +35,23 @@ compare_case() {
         *BAD*) fail "$name: $verdict"; cat "$csv" ;;
         *) ok "$name: error falls with resolution: $verdict" ;;
     esac
+    # CPU time (column 12): positive and, with one thread, not above the
+    # wall time; pareto_cpu (13) is yes exactly when no other run is at least
+    # as accurate and as cheap in CPU time and better in one.
+    cpu=$(awk -F, '!/^#/ && !/^scheme,/ { n++; e[n] = $4; w[n] = $5; c[n] = $12; p[n] = $13; s[n] = $1 "@" $2 }
+        END { for (i = 1; i <= n; i++) {
+                if (!(c[i] + 0 > 0) || c[i] + 0 > 1.1 * w[i] + 0.1) bad = bad " " s[i] ":cpu=" c[i] ",wall=" w[i];
+                front = (e[i] != "nan");
+                for (j = 1; j <= n && front; j++)
+                    if (j != i && e[j] != "nan" && e[j] + 0 <= e[i] + 0 && c[j] + 0 <= c[i] + 0 &&
+                        (e[j] + 0 < e[i] + 0 || c[j] + 0 < c[i] + 0)) front = 0;
+                if ((front ? "yes" : "no") != p[i]) bad = bad " " s[i] ":pareto_cpu=" p[i];
+                printf "%s cpu %s wall %s; ", s[i], c[i], w[i] }
+              if (bad != "") printf "BAD%s", bad }' "$csv")
+    case "$cpu" in
+        *BAD*) fail "$name: $cpu"; cat "$csv" ;;
+        *) ok "$name: CPU time recorded, its Pareto front consistent: $cpu" ;;
+    esac
 }
 
 # hydrostatic2D, shortened: 1 s, averaged after 0.5 s.

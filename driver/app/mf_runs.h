@@ -17,6 +17,8 @@ typedef struct mf_run_summary {
 
 typedef struct mf_child_result {
     double wall_seconds, peak_mb;
+    double cpu_seconds;  /* the child's user + system time (wait4's rusage):
+                            less sensitive than wall time to a loaded machine */
     int exit_status;     /* 128 + signal when killed */
 } mf_child_result;
 
@@ -29,7 +31,7 @@ int mf_case_apply_scheme(const char *run_dir, const char *case_dir, const char *
 /* Copy system/, constant/ and validation/ of a case to a new folder. */
 int mf_case_copy(const char *from, const char *to);
 /* Run the mpsflow executable with argv (argv[0] is replaced by its path),
- * stdout and stderr to log_path; its own wall time and peak memory. */
+ * stdout and stderr to log_path; its own wall time, CPU time and peak memory. */
 int mf_run_child(char *argv[], const char *log_path, mf_child_result *r);
 void mf_read_run_summary(const char *run_dir, mf_run_summary *s);
 /* Entries of src replace those of dst; sub-dictionaries merge. */

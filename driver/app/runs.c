@@ -39,6 +39,8 @@ int mf_run_child(char *argv[], const char *log_path, mf_child_result *r)
         return MF_ERROR(MF_ERR_IO, "waiting for a run failed (%s)", strerror(errno));
     r->wall_seconds = mf_wall_seconds() - t0;
     r->peak_mb = ru.ru_maxrss / 1024.0;
+    r->cpu_seconds = (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec +
+                     (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
     r->exit_status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
     return 0;
 }
