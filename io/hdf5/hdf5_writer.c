@@ -139,18 +139,14 @@ static void fill_piece(const snap_writer *w, const column *c, size_t from, size_
     const size_t *index = w->index + from;
     const size_t nc = (size_t)c->ncomp;
     switch (c->source) {
-    case COLUMN_DOUBLE: {
-        double *dst = w->buf;
-        const double *src = c->data;
-        for (size_t k = 0; k < n; k++)
-            memcpy(dst + k * nc, src + index[k] * nc, nc * sizeof *dst);
-        break;
-    }
+    case COLUMN_DOUBLE:
     case COLUMN_INT32: {
-        int32_t *dst = w->buf;
-        const int32_t *src = c->data;
+        /* Rows of ncomp values copied as bytes, from the particle's row. */
+        const size_t row = nc * (c->source == COLUMN_DOUBLE ? sizeof(double) : sizeof(int32_t));
+        unsigned char *dst = w->buf;
+        const unsigned char *src = c->data;
         for (size_t k = 0; k < n; k++)
-            memcpy(dst + k * nc, src + index[k] * nc, nc * sizeof *dst);
+            memcpy(dst + k * row, src + index[k] * row, row);
         break;
     }
     case COLUMN_ID: {
