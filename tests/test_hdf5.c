@@ -297,11 +297,14 @@ static void check_file_content(const char *path, int dim)
     H5Fclose(file);
 }
 
-/* The file as HDF5 itself would hand out its image (H5Fget_file_image, which
- * the writer no longer calls, to hold the image once): opened read-only in
- * memory, its image must be the file byte for byte, so the writer wrote
- * exactly the image's length and cleared the superblock's consistency flags
- * (bytes 20-23 of a version 0 superblock), set in the writer's open file. */
+/* The file is a closed, whole HDF5 file: opened read-only in memory, its
+ * image (H5Fget_file_image) must be the file byte for byte, so it ends where
+ * HDF5's allocation ends (nothing cut, nothing after) and its superblock's
+ * consistency flags (bytes 20-23 of a version 0 superblock, set while the
+ * writer has the file open) are cleared, as HDF5's close leaves them. The
+ * writer used to build the image itself and had to clear them; now HDF5
+ * writes the file (sec2) and this checks that the close happened. That the
+ * file reads in a fresh process: check_h5dump. */
 static void check_image(const char *path)
 {
     char *bytes = NULL;

@@ -1,26 +1,31 @@
 /* hdf5_writer.c: write one snapshot file (layout in mf_hdf5.h).
  *
- * On one rank the file is built in memory, written as "<path>.tmp" (by us,
- * not HDF5: write_in_memory), synced and renamed: the real name only ever holds a
- * complete file, and a write that fails (a full disk) leaves no HDF5 handle
- * open. Particles are grouped by kind in storage order; StorageIndex
- * records where each came from.
+ * HDF5 writes "<path>.tmp" itself (write_file): through the sec2 driver
+ * (plain POSIX writes) on one rank, through MPI-IO on several (a -parallel
+ * run: parallel HDF5, collective calls). The file is then synced and
+ * renamed: the real name only ever holds a complete file. A write that
+ * fails (a full disk) closes what it can, removes the .tmp and says which
+ * file and why; the snapshots written before are not touched. Particles
+ * are grouped by kind in storage order; StorageIndex records where each
+ * came from. Each dataset is written in pieces of PIECE_ROWS rows through
+ * a staging buffer of that size, not one whole column: neither the file's
+ * image nor a whole column is held in memory.
  *
- * On several ranks (a -parallel run) the file is the same one file, written
- * collectively through MPI-IO (parallel HDF5: write_collective): every rank
- * writes its owned particles of each kind as one block of rows, blocks in
- * rank order (the global storage order: rank 0's particles, then rank 1's,
- * ...), so readers see one snapshot as from a serial run, with each
- * particle's id. The header carries the totals; rank 0 commits the finished
- * file. A disk that fills while HDF5 flushes the file fails its close there
- * (said, the .tmp removed); the in-memory path's guarantee that nothing of
- * HDF5 stays open after such a failure holds on one rank only. */
+ * On several ranks the file is the same one file: every rank writes its
+ * owned particles of each kind as one block of rows, blocks in rank order
+ * (the global storage order: rank 0's particles, then rank 1's, ...), so
+ * readers see one snapshot as from a serial run, with each particle's id.
+ * The header carries the totals; rank 0 commits the finished file. */
+/* memfd_create (Linux, glibc 2.27): see move_to_memory. */
+#define _GNU_SOURCE
 #include <errno.h>
-#include <fcntl.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+#ifdef __linux__
+#include <sys/mman.h>
+#endif
 
 #include "hdf5_internal.h"
 #include "mf_bodies.h"
@@ -31,6 +36,12 @@
 /* Rows per chunk when compressing: 16k rows of 3 doubles is 384 KiB, inside
  * HDF5's default 1 MiB chunk cache. */
 #define CHUNK_ROWS 16384
+/* Rows staged and written at a time. One chunk: a compressed chunk is then
+ * written whole, once (one written in parts would be compressed, stored,
+ * read back and stored again elsewhere: another file than one whole write
+ * makes); the staging buffer is 384 KiB for 3 doubles a row, not the whole
+ * column (2.4 MB on the 3-D bench case's 99,009 particles). */
+#define PIECE_ROWS CHUNK_ROWS
 
 typedef struct snap_writer {
     const char *path;   /* the final name, for messages */
@@ -43,8 +54,28 @@ typedef struct snap_writer {
     hsize_t rows;       /* all ranks' rows of that kind */
     hsize_t first;      /* this rank's first row of that kind */
     int64_t storage0;   /* global storage index of this rank's first particle */
-    void *buf;          /* gather buffer: count * max components * 8 bytes */
+    void *buf;          /* staging buffer: PIECE_ROWS * max components * 8 bytes */
+    int io_errno;       /* errno of the first failed HDF5 write or close, 0 if none */
 } snap_writer;
+
+/* What a dataset's rows are made from (fill_piece). */
+typedef enum {
+    COLUMN_DOUBLE,      /* data: ncomp doubles a particle */
+    COLUMN_INT32,       /* data: ncomp int32 a particle */
+    COLUMN_ID,          /* the particles' ids */
+    COLUMN_STORAGE,     /* their global storage index */
+    COLUMN_POINT_INDEX, /* 0..count-1 within the kind */
+    COLUMN_KIND         /* the kind, one byte */
+} column_source;
+
+typedef struct column {
+    const char *name;
+    column_source source;
+    const void *data;   /* COLUMN_DOUBLE, COLUMN_INT32 */
+    int ncomp;
+    int kind;           /* COLUMN_KIND */
+    hid_t file_type, mem_type;
+} column;
 
 /* Create group name in parent; on failure an MF_ERR_IO naming what (the
  * group's file:/path) and HDF5's reason, and *g < 0. */
@@ -102,18 +133,83 @@ static int write_parameters(const snap_writer *w, const mf_dict *params)
     return 0;
 }
 
-/* One dataset of w->count rows and ncomp columns (rank 1 when ncomp == 1)
- * from the gathered buffer. */
-static int write_dataset(const snap_writer *w, hid_t group, const char *group_name,
-                         const char *name, int ncomp, hid_t file_type, hid_t mem_type)
+/* Rows from .. from + n of this rank's particles of the kind into w->buf. */
+static void fill_piece(const snap_writer *w, const column *c, size_t from, size_t n)
+{
+    const size_t *index = w->index + from;
+    const size_t nc = (size_t)c->ncomp;
+    switch (c->source) {
+    case COLUMN_DOUBLE:
+    case COLUMN_INT32: {
+        /* Rows of ncomp values copied as bytes, from the particle's row. */
+        const size_t row = nc * (c->source == COLUMN_DOUBLE ? sizeof(double) : sizeof(int32_t));
+        unsigned char *dst = w->buf;
+        const unsigned char *src = c->data;
+        for (size_t k = 0; k < n; k++)
+            memcpy(dst + k * row, src + index[k] * row, row);
+        break;
+    }
+    case COLUMN_ID: {
+        int64_t *dst = w->buf;
+        for (size_t k = 0; k < n; k++)
+            dst[k] = w->p->id[index[k]];
+        break;
+    }
+    case COLUMN_STORAGE: {
+        int64_t *dst = w->buf;
+        for (size_t k = 0; k < n; k++)
+            dst[k] = w->storage0 + (int64_t)index[k];
+        break;
+    }
+    case COLUMN_POINT_INDEX: {
+        int32_t *dst = w->buf;
+        for (size_t k = 0; k < n; k++)
+            dst[k] = (int32_t)(from + k);
+        break;
+    }
+    case COLUMN_KIND:
+        memset(w->buf, c->kind, n);
+        break;
+    }
+}
+
+/* This rank's rows from .. from + n (n may be 0: an empty selection, for a
+ * collective write needs every rank) of the dataset, from w->buf. */
+static herr_t write_piece(const snap_writer *w, hid_t dset, hid_t space, int rank, int ncomp,
+                          hid_t mem_type, size_t from, size_t n)
+{
+    hsize_t start[2] = {w->first + from, 0}, count[2] = {n, (hsize_t)ncomp};
+    hid_t mem = H5Screate_simple(rank, count, NULL);
+    hid_t dxpl = H5Pcreate(H5P_DATASET_XFER);
+    herr_t rc = mem < 0 || dxpl < 0 ? -1 : 0;
+    if (rc == 0 && w->par)
+        rc = H5Pset_dxpl_mpio(dxpl, H5FD_MPIO_COLLECTIVE);
+    if (rc == 0)
+        rc = n ? H5Sselect_hyperslab(space, H5S_SELECT_SET, start, NULL, count, NULL)
+               : H5Sselect_none(space);
+    if (rc == 0 && !n)
+        rc = H5Sselect_none(mem);
+    if (rc == 0)
+        rc = H5Dwrite(dset, mem_type, mem, space, dxpl, w->buf);
+    mf_h5_close(&dxpl);
+    mf_h5_close(&mem);
+    return rc;
+}
+
+/* One dataset of w->rows rows and c->ncomp columns (rank 1 when ncomp ==
+ * 1), this rank's w->count of them written PIECE_ROWS at a time (every
+ * rank the same number of pieces). A failed write or close notes its errno
+ * in w->io_errno: closing the dataset writes what HDF5 still holds of it
+ * (its sieve buffer), so that close can fail on a full disk too. */
+static int write_dataset(snap_writer *w, hid_t group, const char *group_name, const column *c)
 {
     char what[MF_H5_PATH_MAX], detail[256];
-    snprintf(what, sizeof what, "%s:/%s/%s", w->path, group_name, name);
-    hsize_t dims[2] = {w->rows, (hsize_t)ncomp};
-    int rank = ncomp == 1 ? 1 : 2;
+    snprintf(what, sizeof what, "%s:/%s/%s", w->path, group_name, c->name);
+    hsize_t dims[2] = {w->rows, (hsize_t)c->ncomp};
+    int rank = c->ncomp == 1 ? 1 : 2;
     hid_t space = H5Screate_simple(rank, dims, NULL);
     hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
-    hid_t dset = H5I_INVALID_HID, mem = H5I_INVALID_HID, dxpl = H5P_DEFAULT;
+    hid_t dset = H5I_INVALID_HID;
     int rc = 0;
     if (space < 0 || dcpl < 0) {
         rc = MF_ERROR(MF_ERR_IO, "%s: cannot create the dataspace (%s)", what,
@@ -121,7 +217,7 @@ static int write_dataset(const snap_writer *w, hid_t group, const char *group_na
         goto done;
     }
     if (w->compression > 0) {
-        hsize_t chunk[2] = {w->rows < CHUNK_ROWS ? w->rows : CHUNK_ROWS, (hsize_t)ncomp};
+        hsize_t chunk[2] = {w->rows < CHUNK_ROWS ? w->rows : CHUNK_ROWS, (hsize_t)c->ncomp};
         /* Shuffle groups the bytes of equal significance: gzip then finds
          * the repeated exponents of neighbouring doubles. Both lossless. */
         if (H5Pset_chunk(dcpl, rank, chunk) < 0 || H5Pset_shuffle(dcpl) < 0 ||
@@ -131,71 +227,38 @@ static int write_dataset(const snap_writer *w, hid_t group, const char *group_na
             goto done;
         }
     }
-    dset = H5Dcreate2(group, name, file_type, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+    dset = H5Dcreate2(group, c->name, c->file_type, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
     herr_t wrc = dset < 0 ? -1 : 0;
-    if (wrc == 0 && !w->par) {
-        wrc = H5Dwrite(dset, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, w->buf);
-    } else if (wrc == 0) {
-        /* This rank's block of rows; every rank takes part (an empty
-         * selection on a rank with none), as a collective write must. */
-        hsize_t start[2] = {w->first, 0}, count[2] = {w->count, (hsize_t)ncomp};
-        mem = H5Screate_simple(rank, count, NULL);
-        dxpl = H5Pcreate(H5P_DATASET_XFER);
-        wrc = mem < 0 || dxpl < 0 || H5Pset_dxpl_mpio(dxpl, H5FD_MPIO_COLLECTIVE) < 0 ? -1 : 0;
-        if (wrc == 0)
-            wrc = w->count ? H5Sselect_hyperslab(space, H5S_SELECT_SET, start, NULL, count, NULL)
-                           : H5Sselect_none(space);
-        if (wrc == 0 && !w->count)
-            wrc = H5Sselect_none(mem);
-        if (wrc == 0)
-            wrc = H5Dwrite(dset, mem_type, mem, space, dxpl, w->buf);
+    int64_t pieces = (int64_t)((w->count + PIECE_ROWS - 1) / PIECE_ROWS);
+    mf_parallel_max_i64(w->par, &pieces, 1);
+    for (int64_t k = 0; wrc >= 0 && k < pieces; k++) {
+        size_t from = (size_t)k * PIECE_ROWS;
+        size_t n = from >= w->count ? 0 : w->count - from < PIECE_ROWS ? w->count - from
+                                                                        : PIECE_ROWS;
+        fill_piece(w, c, from, n);
+        wrc = write_piece(w, dset, space, rank, c->ncomp, c->mem_type, from, n);
     }
     if (wrc < 0) {
+        if (!w->io_errno)
+            w->io_errno = errno;
         rc = MF_ERROR(MF_ERR_IO, "%s: cannot write the dataset (%s)", what,
                       mf_h5_error_detail(detail, sizeof detail));
         goto done;
     }
-    rc = mf_h5_attr_write_string(dset, "Units", mf_h5_unit(name), what);
+    MF_CALL_GOTO(rc, mf_h5_attr_write_string(dset, "Units", mf_h5_unit(c->name), what), done);
+    herr_t closed = H5Dclose(dset);
+    dset = H5I_INVALID_HID;
+    if (closed < 0) {
+        if (!w->io_errno)
+            w->io_errno = errno;
+        rc = MF_ERROR(MF_ERR_IO, "%s: cannot finish the dataset (%s)", what,
+                      mf_h5_error_detail(detail, sizeof detail));
+    }
 done:
-    if (dxpl != H5P_DEFAULT)
-        mf_h5_close(&dxpl);
-    mf_h5_close(&mem);
     mf_h5_close(&dset);
     mf_h5_close(&dcpl);
     mf_h5_close(&space);
     return rc;
-}
-
-/* For ParaView's Xdmf3 readers (the default for .xdmf), which make no cells
- * of a Polyvertex topology without connectivity: PointIndex (0..n-1, one
- * vertex cell per particle) and Kind (the group's kind, so that the
- * partitioned reader, which merges the groups, can still tell them apart). */
-static int write_viewer_datasets(const snap_writer *w, hid_t g, const char *group_name, int kind)
-{
-    int32_t *index = w->buf;
-    for (size_t k = 0; k < w->count; k++)
-        index[k] = (int32_t)k;
-    MF_CALL(write_dataset(w, g, group_name, "PointIndex", 1, H5T_STD_I32LE, H5T_NATIVE_INT32));
-    uint8_t *kinds = w->buf;
-    memset(kinds, kind, w->count);
-    MF_CALL(write_dataset(w, g, group_name, "Kind", 1, H5T_STD_U8LE, H5T_NATIVE_UINT8));
-    return 0;
-}
-
-static void gather_double(const snap_writer *w, const double *src, int ncomp)
-{
-    double *dst = w->buf;
-    for (size_t k = 0; k < w->count; k++)
-        memcpy(dst + k * (size_t)ncomp, src + w->index[k] * (size_t)ncomp,
-               (size_t)ncomp * sizeof *dst);
-}
-
-static void gather_int32(const snap_writer *w, const int32_t *src, int ncomp)
-{
-    int32_t *dst = w->buf;
-    for (size_t k = 0; k < w->count; k++)
-        memcpy(dst + k * (size_t)ncomp, src + w->index[k] * (size_t)ncomp,
-               (size_t)ncomp * sizeof *dst);
 }
 
 static int write_kind(snap_writer *w, int kind)
@@ -216,32 +279,29 @@ static int write_kind(snap_writer *w, int kind)
     int rc = 0;
     MF_CALL_GOTO(rc, mf_h5_attr_write_string(g, "KindName", mf_h5_kind_name(kind), what), done);
 
-    gather_double(w, p->pos, 3);
-    MF_CALL_GOTO(rc, write_dataset(w, g, group_name, "Coordinates", 3, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE), done);
-    gather_double(w, p->vel, 3);
-    MF_CALL_GOTO(rc, write_dataset(w, g, group_name, "Velocities", 3, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE), done);
-    int64_t *ids = w->buf;
-    for (size_t k = 0; k < w->count; k++)
-        ids[k] = p->id[w->index[k]];
-    MF_CALL_GOTO(rc, write_dataset(w, g, group_name, "ParticleIDs", 1, H5T_STD_I64LE, H5T_NATIVE_INT64), done);
-    for (size_t k = 0; k < w->count; k++)
-        ids[k] = w->storage0 + (int64_t)w->index[k];
-    MF_CALL_GOTO(rc, write_dataset(w, g, group_name, "StorageIndex", 1, H5T_STD_I64LE, H5T_NATIVE_INT64), done);
-    MF_CALL_GOTO(rc, write_viewer_datasets(w, g, group_name, kind), done);
+    /* PointIndex (0..n-1, one vertex cell per particle) and Kind (the
+     * group's kind) are for ParaView's Xdmf3 readers (the default for
+     * .xdmf), which make no cells of a Polyvertex topology without
+     * connectivity, and whose partitioned reader merges the groups. */
+    const column core[] = {
+        {"Coordinates", COLUMN_DOUBLE, p->pos, 3, 0, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE},
+        {"Velocities", COLUMN_DOUBLE, p->vel, 3, 0, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE},
+        {"ParticleIDs", COLUMN_ID, NULL, 1, 0, H5T_STD_I64LE, H5T_NATIVE_INT64},
+        {"StorageIndex", COLUMN_STORAGE, NULL, 1, 0, H5T_STD_I64LE, H5T_NATIVE_INT64},
+        {"PointIndex", COLUMN_POINT_INDEX, NULL, 1, 0, H5T_STD_I32LE, H5T_NATIVE_INT32},
+        {"Kind", COLUMN_KIND, NULL, 1, kind, H5T_STD_U8LE, H5T_NATIVE_UINT8}};
+    for (size_t k = 0; k < sizeof core / sizeof core[0]; k++)
+        MF_CALL_GOTO(rc, write_dataset(w, g, group_name, &core[k]), done);
 
     for (int f = 0; f < p->nfields; f++) {
         const mf_field *field = &p->field[f];
         if (!field->output)
             continue;
-        if (field->type == MF_FIELD_DOUBLE) {
-            gather_double(w, field->data, field->ncomp);
-            MF_CALL_GOTO(rc, write_dataset(w, g, group_name, field->name, field->ncomp,
-                                           H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE), done);
-        } else {
-            gather_int32(w, field->data, field->ncomp);
-            MF_CALL_GOTO(rc, write_dataset(w, g, group_name, field->name, field->ncomp,
-                                           H5T_STD_I32LE, H5T_NATIVE_INT32), done);
-        }
+        const bool dbl = field->type == MF_FIELD_DOUBLE;
+        const column c = {field->name, dbl ? COLUMN_DOUBLE : COLUMN_INT32, field->data,
+                          field->ncomp, 0, dbl ? H5T_IEEE_F64LE : H5T_STD_I32LE,
+                          dbl ? H5T_NATIVE_DOUBLE : H5T_NATIVE_INT32};
+        MF_CALL_GOTO(rc, write_dataset(w, g, group_name, &c), done);
     }
 done:
     H5Gclose(g);
@@ -366,215 +426,100 @@ static int write_contents(snap_writer *w, const mf_sim *sim, const mf_dict *para
     return 0;
 }
 
-/* The core driver's memory, allocated through HDF5's file image callbacks
- * (H5Pset_file_image_callbacks) so that we know where it is: the finished
- * image is written to the disk from there, not from a copy of it. */
-typedef struct image_store {
-    unsigned char *mem; /* the driver's buffer, NULL until its first write */
-    size_t size;        /* its allocated bytes (a multiple of the increment) */
-} image_store;
-
-static void *image_malloc(size_t size, H5FD_file_image_op_t op, void *udata)
+/* A system call under HDF5 failed with err (a full disk: ENOSPC): which
+ * file, why, that it is removed and that the snapshots before are whole;
+ * HDF5's own message after. */
+static int io_failure(const char *tmp, int err)
 {
-    (void)op;
-    image_store *store = udata;
-    void *mem = malloc(size);
-    if (mem) {
-        store->mem = mem;
-        store->size = size;
-    }
-    return mem;
+    char inner[1024];
+    snprintf(inner, sizeof inner, "%s", mf_error_message());
+    return MF_ERROR(MF_ERR_IO,
+                    "cannot write %s: %s (errno %d); it is removed, the snapshots written "
+                    "before are whole%s (%s)",
+                    tmp, strerror(err), err,
+                    err == ENOSPC || err == EDQUOT ? ": free space on that disk and restart "
+                                                     "with -latestTime"
+                                                   : "",
+                    inner);
 }
 
-/* Called only for an image given at open (H5Pset_file_image): none here. */
-static void *image_memcpy(void *dest, const void *src, size_t size, H5FD_file_image_op_t op,
-                          void *udata)
+/* After a failed write on one rank: HDF5's descriptor of tmp (the sec2
+ * driver's) is pointed at an anonymous file in memory (memfd_create, dup2)
+ * and the file flushed there, so that what HDF5 still holds cannot fail
+ * again for want of disk space and the file can be closed; tmp itself is
+ * removed by the caller. Emptying tmp instead was not enough: the metadata
+ * left to flush lies across the file, a page of disk each, more than a
+ * nearly full disk has (a 300 KiB tmpfs, docs/notes/speed.md, memory4).
+ * False if that cannot be done (then the file must stay open). */
+static bool move_to_memory(hid_t file)
 {
-    (void)op;
-    (void)udata;
-    return memcpy(dest, src, size);
+#ifdef __linux__
+    int *fd = NULL;
+    if (H5Fget_vfd_handle(file, H5P_DEFAULT, (void **)&fd) < 0 || !fd)
+        return false;
+    int mem = memfd_create("mpsflow-failed-snapshot", MFD_CLOEXEC);
+    if (mem < 0)
+        return false;
+    bool moved = dup2(mem, *fd) >= 0;
+    close(mem);
+    return moved && H5Fflush(file, H5F_SCOPE_GLOBAL) >= 0;
+#else
+    (void)file;
+    return false;
+#endif
 }
 
-static void *image_realloc(void *ptr, size_t size, H5FD_file_image_op_t op, void *udata)
-{
-    (void)op;
-    image_store *store = udata;
-    void *mem = realloc(ptr, size);
-    if (mem) {
-        store->mem = mem;
-        store->size = size;
-    }
-    return mem;
-}
-
-static herr_t image_free(void *ptr, H5FD_file_image_op_t op, void *udata)
-{
-    (void)op;
-    image_store *store = udata;
-    if (ptr == store->mem) {
-        store->mem = NULL;
-        store->size = 0;
-    }
-    free(ptr);
-    return 0;
-}
-
-/* The fapl is copied into the file: the copy points at the same store. */
-static void *image_udata_copy(void *udata) { return udata; }
-static herr_t image_udata_free(void *udata)
-{
-    (void)udata;
-    return 0;
-}
-
-/* Bytes of the file as written: a run of the driver's buffer, or zeros. */
-typedef struct image_piece {
-    const unsigned char *bytes;
-    size_t size;
-} image_piece;
-
-static int write_image(const char *tmp, const image_piece *piece, int npieces);
-
-/* The superblock's file consistency flags (HDF5 file format specification,
- * superblock versions 0 and 1: 4 bytes at offset 20, after the signature,
- * the versions, the sizes and the two group K values). An open file has
- * its write-access bit set there; H5Fget_file_image clears the flags in the
- * image it returns, as a file is left on close. Versions 2 and 3 (which
- * mf_h5_fapl never asks for: the library's default, the earliest format)
- * keep one byte at offset 11 under the superblock's checksum. */
-#define SUPERBLOCK_VERSION_AT 8
-#define SUPERBLOCK_V01_FLAGS_AT 20
-#define SUPERBLOCK_V01_FLAGS_SIZE 4
-
-/* One rank: the snapshot is built in memory (HDF5's core driver, no
- * backing store) and written to tmp by us in one go, from the driver's own
- * buffer, before the file is closed: HDF5 itself never writes to the disk,
- * so a full disk (or any write error) is a failed write() of ours, reported
- * with its errno, after which nothing of HDF5 is left open. With HDF5
- * writing the file itself, a failure while it flushed left the file open
- * inside the library, and closing it at exit crashed. The cost is the
- * file's image in memory while it is built and written, once: taking it
- * with H5Fget_file_image would copy it whole (8.8 MB on the 3-D bench case,
- * which set the run's peak). The bytes written are those H5Fget_file_image
- * returns after the flush: the first eoa bytes of the driver's buffer with
- * the superblock's consistency flags cleared (test_hdf5 checks the two
- * against each other). */
-static int write_in_memory(snap_writer *w, const char *tmp, const mf_sim *sim,
-                           const mf_dict *params, const int64_t counts[MF_NKINDS])
+/* tmp written by HDF5 itself: the sec2 driver on one rank, MPI-IO on
+ * several (collective calls throughout, each rank its block of rows).
+ *
+ * The file is flushed before it is closed: a close that fails (a disk that
+ * fills while HDF5 writes its metadata) leaves HDF5 1.10 holding a file it
+ * has half freed, and its next close (ours, or the library's at exit,
+ * inside MPI_Finalize) crashes; a failed flush leaves the file whole and
+ * open, to be flushed again. After a failure on one rank the file is
+ * moved to memory (move_to_memory) and closed, everything of it. If that
+ * cannot be done, the file is left open rather than closed into the
+ * crash. Several ranks: HDF5 writes through MPI-IO, there is no descriptor
+ * to move; a failure closes what it can, as before. */
+static int write_file(snap_writer *w, const char *tmp, const mf_sim *sim,
+                      const mf_dict *params, const int64_t counts[MF_NKINDS])
 {
     char detail[256];
-    image_store store = {0};
-    H5FD_file_image_callbacks_t callbacks = {
-        .image_malloc = image_malloc,         .image_memcpy = image_memcpy,
-        .image_realloc = image_realloc,       .image_free = image_free,
-        .udata_copy = image_udata_copy,       .udata_free = image_udata_free,
-        .udata = &store};
     hid_t fapl = mf_h5_fapl();
-    if (fapl >= 0 && (H5Pset_fapl_core(fapl, (size_t)1 << 20, 0) < 0 ||
-                      H5Pset_file_image_callbacks(fapl, &callbacks) < 0))
+    if (fapl >= 0 &&
+        (w->par ? H5Pset_fapl_mpio(fapl, mf_parallel_comm(w->par), MPI_INFO_NULL)
+                : H5Pset_fapl_sec2(fapl)) < 0)
         mf_h5_close(&fapl);
-    w->file = fapl < 0 ? H5I_INVALID_HID : H5Fcreate(w->path, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+    w->file = fapl < 0 ? H5I_INVALID_HID : H5Fcreate(tmp, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
     /* Take the message before any other HDF5 call clears the error stack. */
     mf_h5_error_detail(detail, sizeof detail);
     mf_h5_close(&fapl);
     if (w->file < 0)
-        return MF_ERROR(MF_ERR_IO, "cannot create %s in memory (%s)", w->path, detail);
-    int rc = 0;
-    MF_CALL_GOTO(rc, write_contents(w, sim, params, counts), done);
-    /* Flushed first: the image must hold the metadata still in HDF5's
-     * caches. With no buffer H5Fget_file_image only says the image's size
-     * (its end of allocation), all of it written, so inside the buffer. */
-    ssize_t n = H5Fflush(w->file, H5F_SCOPE_GLOBAL) < 0 ? -1 : H5Fget_file_image(w->file, NULL, 0);
-    if (n <= 0 || !store.mem || (size_t)n > store.size) {
-        rc = MF_ERROR(MF_ERR_IO, "cannot finish %s in memory (%s)", w->path,
-                      n <= 0 ? mf_h5_error_detail(detail, sizeof detail)
-                             : "its end lies past the driver's buffer");
-        goto done;
-    }
-    unsigned version = store.mem[SUPERBLOCK_VERSION_AT];
-    if (version > 1 || (size_t)n < SUPERBLOCK_V01_FLAGS_AT + SUPERBLOCK_V01_FLAGS_SIZE) {
-        rc = MF_ERROR(MF_ERR_INTERNAL, "%s: superblock version %u (%zd bytes): this writer "
-                      "clears the flags of versions 0 and 1 only", w->path, version, n);
-        goto done;
-    }
-    static const unsigned char cleared[SUPERBLOCK_V01_FLAGS_SIZE] = {0};
-    const size_t after = SUPERBLOCK_V01_FLAGS_AT + SUPERBLOCK_V01_FLAGS_SIZE;
-    const image_piece piece[] = {{store.mem, SUPERBLOCK_V01_FLAGS_AT},
-                                 {cleared, SUPERBLOCK_V01_FLAGS_SIZE},
-                                 {store.mem + after, (size_t)n - after}};
-    rc = write_image(tmp, piece, 3);
-done:
-    close_all(&w->file);
-    return rc;
-}
-
-/* Several ranks: tmp written by all of them through MPI-IO, each its block
- * of rows (collective calls throughout). */
-static int write_collective(snap_writer *w, const char *tmp, const mf_sim *sim,
-                            const mf_dict *params, const int64_t counts[MF_NKINDS])
-{
-    char detail[256];
-    hid_t fapl = mf_h5_fapl();
-    if (fapl >= 0 && H5Pset_fapl_mpio(fapl, mf_parallel_comm(w->par), MPI_INFO_NULL) < 0)
-        mf_h5_close(&fapl);
-    w->file = fapl < 0 ? H5I_INVALID_HID : H5Fcreate(tmp, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
-    mf_h5_error_detail(detail, sizeof detail);
-    mf_h5_close(&fapl);
-    if (w->file < 0)
         return MF_ERROR(MF_ERR_IO, "cannot create %s (%s)", tmp, detail);
+    errno = 0;
+    w->io_errno = 0;
     int rc = write_contents(w, sim, params, counts);
-    if (rc != 0) {
-        close_all(&w->file);
-        return mf_error_trace(rc, __FILE__, __LINE__, __func__);
+    if (rc == 0 && H5Fflush(w->file, H5F_SCOPE_GLOBAL) < 0) {
+        w->io_errno = errno;
+        rc = MF_ERROR(MF_ERR_IO, "cannot finish writing %s (%s)", tmp,
+                      mf_h5_error_detail(detail, sizeof detail));
     }
-    /* Closing flushes: a full disk shows up here. */
-    herr_t closed = H5Fclose(w->file);
-    w->file = H5I_INVALID_HID;
-    if (closed < 0)
-        return MF_ERROR(MF_ERR_IO, "cannot finish writing %s (%s)", tmp,
-                        mf_h5_error_detail(detail, sizeof detail));
-    return 0;
-}
-
-/* The pieces of the file, in order, to tmp, synced: a short write or a
- * failed sync removes tmp. */
-static int write_image(const char *tmp, const image_piece *piece, int npieces)
-{
-    size_t size = 0;
-    for (int k = 0; k < npieces; k++)
-        size += piece[k].size;
-    int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
-    if (fd < 0)
-        return MF_ERROR(MF_ERR_IO, "cannot create %s (%s, errno %d)", tmp, strerror(errno), errno);
-    size_t done = 0;
-    int err = 0;
-    for (int k = 0; k < npieces && !err; k++) {
-        size_t put_of = 0;
-        while (put_of < piece[k].size && !err) {
-            ssize_t put = write(fd, piece[k].bytes + put_of, piece[k].size - put_of);
-            if (put < 0 && errno == EINTR)
-                continue;
-            if (put <= 0)
-                err = put < 0 ? errno : ENOSPC;
-            else
-                put_of += (size_t)put;
+    if (rc == 0) {
+        herr_t closed = H5Fclose(w->file);
+        w->file = H5I_INVALID_HID; /* never closed twice (above) */
+        if (closed < 0) {
+            w->io_errno = errno;
+            rc = MF_ERROR(MF_ERR_IO, "cannot close %s (%s)", tmp,
+                          mf_h5_error_detail(detail, sizeof detail));
         }
-        done += put_of;
     }
-    if (!err && fsync(fd) != 0 && errno != EINVAL)
-        err = errno;
-    if (close(fd) != 0 && !err)
-        err = errno;
-    if (!err)
+    if (rc == 0)
         return 0;
-    unlink(tmp);
-    return MF_ERROR(MF_ERR_IO,
-                    "cannot write %s: %s (errno %d) after %zu of %zu bytes; it is removed, the "
-                    "snapshots written before are whole%s",
-                    tmp, strerror(err), err, done, size,
-                    err == ENOSPC || err == EDQUOT ? ": free space on that disk and restart "
-                                                     "with -latestTime"
-                                                   : "");
+    if (w->par || w->file < 0 || move_to_memory(w->file))
+        close_all(&w->file);
+    if (w->io_errno)
+        return io_failure(tmp, w->io_errno);
+    return mf_error_trace(rc, __FILE__, __LINE__, __func__);
 }
 
 int mf_hdf5_write_snapshot(const char *path, const mf_sim *sim, const mf_dict *params,
@@ -598,7 +543,7 @@ int mf_hdf5_write_snapshot(const char *path, const mf_sim *sim, const mf_dict *p
     w.storage0 = mf_parallel_exscan(sim->par, (int64_t)p->n_owned);
     size_t n = p->n_owned > 0 ? p->n_owned : 1;
     w.index = malloc(n * sizeof *w.index);
-    w.buf = malloc(n * (size_t)max_ncomp * sizeof(double));
+    w.buf = malloc((n < PIECE_ROWS ? n : PIECE_ROWS) * (size_t)max_ncomp * sizeof(double));
     int rc = !w.index || !w.buf
                  ? MF_ERROR(MF_ERR_MEMORY, "%s: out of memory for %zu particles", path, n)
                  : 0;
@@ -611,8 +556,7 @@ int mf_hdf5_write_snapshot(const char *path, const mf_sim *sim, const mf_dict *p
 
     mf_h5_quiet quiet;
     mf_h5_quiet_begin(&quiet);
-    rc = sim->par ? write_collective(&w, tmp, sim, params, counts)
-                  : write_in_memory(&w, tmp, sim, params, counts);
+    rc = write_file(&w, tmp, sim, params, counts);
     mf_h5_quiet_end(&quiet);
     free(w.index);
     free(w.buf);
