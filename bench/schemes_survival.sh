@@ -18,6 +18,8 @@
 #   fixedDt          damBreak2D at fixed dt 1e-4 and 5e-5, l0 0.01, to 0.6 s (issue: paper stops in 0.1 s)
 #   tank3D           bench/cases/restingTank in 3-D at the damBreak3D settings, 1 s
 #   damBreak2D       tutorials/damBreak2D at 0.02, 0.01 and 0.005 m, front error (validate)
+#   extreme          bench/cases/extreme/* at 0.02, 0.01 (their own) and 0.005 m
+#   waterAirCoarse   tutorials/waterAirDamBreak at 0.04 m (a third spacing)
 # Writes bench/results/schemes_survival.csv (appends).
 cd "$(dirname "$0")/.." || exit 1
 MPSFLOW=${MPSFLOW:-$PWD/build/driver/mpsflow}
@@ -25,7 +27,7 @@ MPSFLOW=${MPSFLOW:-$PWD/build/driver/mpsflow}
 export OMP_NUM_THREADS=1
 out=bench/results; mkdir -p "$out"
 csv=$out/schemes_survival.csv
-[ -f "$csv" ] || echo "case,l0,variant,end,reached,steps,retries,ke_max_J,speed_max,seconds,validate,stop" > "$csv"
+[ -f "$csv" ] || echo "case,l0,variant,end,reached,steps,retries,ke_max_J,speed_max,seconds,validate,stop,watch_peak" > "$csv"
 work=$(mktemp -d)
 [ -n "$KEEP" ] || trap 'rm -rf "$work"' EXIT
 [ $# -gt 0 ] || set -- paper stab robust
@@ -67,13 +69,15 @@ one() {
     [ $rc = 0 ] || stop=$(grep -m1 -E 'unstable|through|error|Error|failed' "$d/log" | tr ',' ';' | cut -c1-140)
     ke=$(awk '!/^#/ { if ($2 > m) m = $2; if ($3 > u) u = $3 } END { printf "%.4g,%.3g", m, u }' \
         "$d/postProcessing/energy/kineticEnergy.dat" 2>/dev/null)
+    # how close the run came to the energy criterion (the log's Watch: line)
+    peak=$(sed -n 's/^Watch: kinetic energy above.* by at most \([^ ]*\) of the energy scale.*/\1/p' "$d/log")
     val=""
     if [ $rc = 0 ] && [ -d "$d/validation" ]; then
         val=$("$MPSFLOW" validate -case "$d" 2>&1 | awk '/^[Ee]rror / { print $NF }' | head -1)
     fi
-    printf "%-15s l0 %-8s %-12s end %-5s reached %-8s steps %6s retries %3s KE max, speed max %-14s %6s s  validate %-9s %s\n" \
-        "$name" "$l0" "$vname" "$end" "$reached" "$steps" "$retries" "$ke" "$secs" "$val" "$stop"
-    echo "$name,$l0,$vname,$end,$reached,$steps,$retries,$ke,$secs,$val,$stop" >> "$csv"
+    printf "%-15s l0 %-8s %-12s end %-5s reached %-8s steps %6s retries %3s KE max, speed max %-14s %6s s  validate %-9s watch %-9s %s\n" \
+        "$name" "$l0" "$vname" "$end" "$reached" "$steps" "$retries" "$ke" "$secs" "$val" "$peak" "$stop"
+    echo "$name,$l0,$vname,$end,$reached,$steps,$retries,$ke,$secs,$val,$stop,$peak" >> "$csv"
 }
 
 # The 3-D resting tank at the damBreak3D settings (l0 0.025 m, radii 3.1,
@@ -108,6 +112,11 @@ tutorials/damBreak2D|fixedDt$dt|0.01|$v|s/^deltaT .*/deltaT $dt;/;s/^adjustTimeS
 $work/tank3D_src|tank3D|0.025|$v|" ;;
         damBreak2D) for l in 0.02 0.01 0.005; do list="$list
 tutorials/damBreak2D|damBreak2D|$l|$v|"; done ;;
+        extreme) for e in ${EXTREME:-columnImpact cornerJet freeFall overlapped singleParticle thinSheet}; do
+            for l in 0.02 0.01 0.005; do list="$list
+bench/cases/extreme/$e|$e|$l|$v|"; done; done ;;
+        waterAirCoarse) list="$list
+tutorials/waterAirDamBreak|waterAir|0.04|$v|" ;;
         esac
     done
 done
