@@ -183,6 +183,9 @@ extern const mf_param mps_params[MPS_NPARAMS];
 extern const char *const mps_viscosity_choices[]; /* explicit, implicit */
 extern const char *const mps_wall_choices[];      /* particles, wallWeight */
 extern const char *const mps_gradient_weight_choices[]; /* paper, wendland, wendlandW */
+/* The index of word in a NULL-ended choices list, -1 if absent (the
+ * parameter table has checked the word; mps_scheme.c). */
+int mps_choice(const char *const *choices, const char *word);
 /* mps_scheme.c */
 extern const char *const mps_scheme_choices[], *const mps_source_choices[],
     *const mps_gradient_choices[], *const mps_laplacian_choices[], *const mps_shifting_choices[],

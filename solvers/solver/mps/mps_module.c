@@ -150,11 +150,9 @@ static int refuse_wall_pressure(const mps_settings *s, const mps_scheme *sc, con
 static int gradient_weight(const mps_settings *s, const mps_scheme *sc,
                            const mf_dict *solver_dict, mf_kernel *k)
 {
-    int shape = MF_GRAD_WEIGHT_PAPER;
-    for (int c = 0; s->gradient_weight && mps_gradient_weight_choices[c]; c++)
-        if (strcmp(s->gradient_weight, mps_gradient_weight_choices[c]) == 0)
-            shape = c;
-    if (shape == MF_GRAD_WEIGHT_PAPER)
+    const int shape =
+        s->gradient_weight ? mps_choice(mps_gradient_weight_choices, s->gradient_weight) : -1;
+    if (shape <= MF_GRAD_WEIGHT_PAPER)
         return 0;
     if (sc->gradient == MPS_GRADIENT_LEAST_SQUARES) {
         char where[512];

@@ -63,8 +63,7 @@ static const mps_scheme schemes[] = {
      MPS_DETECT_NUMBER_DENSITY, true, 0.2},
 };
 
-/* The index of word in choices (the parameter table has checked it). */
-static int choice(const char *const *choices, const char *word)
+int mps_choice(const char *const *choices, const char *word)
 {
     for (int k = 0; choices[k]; k++)
         if (strcmp(choices[k], word) == 0)
@@ -75,36 +74,36 @@ static int choice(const char *const *choices, const char *word)
 int mps_scheme_resolve(const mps_settings *s, int dim, mps_scheme *out)
 {
     (void)dim;
-    const int k = choice(mps_scheme_choices, s->scheme);
+    const int k = mps_choice(mps_scheme_choices, s->scheme);
     if (k < 0)
         return MF_ERROR(MF_ERR_INPUT, "MPSCoeffs: unknown scheme '%s'", s->scheme);
     *out = schemes[k];
     if (s->relaxation > 0)
         out->relaxation = s->relaxation;
     /* choice k of a list whose entry 0 is "scheme": the enum value k - 1 */
-    int c = choice(mps_source_choices, s->source);
+    int c = mps_choice(mps_source_choices, s->source);
     if (c > 0)
         out->source = (mps_source_kind)(c - 1);
-    c = choice(mps_gradient_choices, s->gradient);
+    c = mps_choice(mps_gradient_choices, s->gradient);
     if (c > 0)
         out->gradient = (mps_gradient_kind)(c - 1);
-    c = choice(mps_laplacian_choices, s->laplacian);
+    c = mps_choice(mps_laplacian_choices, s->laplacian);
     if (c > 0)
         out->laplacian = (mps_laplacian_kind)(c - 1);
-    c = choice(mps_shifting_choices, s->shifting);
+    c = mps_choice(mps_shifting_choices, s->shifting);
     if (c > 0)
         out->shifting = (mps_shift_kind)(c - 1);
-    c = choice(mps_detection_choices, s->surface_detection);
+    c = mps_choice(mps_detection_choices, s->surface_detection);
     if (c > 0)
         out->detection = (mps_detection_kind)(c - 1);
-    c = choice(mps_collision_choices, s->collision_choice);
+    c = mps_choice(mps_collision_choices, s->collision_choice);
     if (c > 0)
         out->collision = c % 2 == 1; /* yes, true, on */
-    if (c < 0 || choice(mps_source_choices, s->source) < 0 ||
-        choice(mps_gradient_choices, s->gradient) < 0 ||
-        choice(mps_laplacian_choices, s->laplacian) < 0 ||
-        choice(mps_shifting_choices, s->shifting) < 0 ||
-        choice(mps_detection_choices, s->surface_detection) < 0)
+    if (c < 0 || mps_choice(mps_source_choices, s->source) < 0 ||
+        mps_choice(mps_gradient_choices, s->gradient) < 0 ||
+        mps_choice(mps_laplacian_choices, s->laplacian) < 0 ||
+        mps_choice(mps_shifting_choices, s->shifting) < 0 ||
+        mps_choice(mps_detection_choices, s->surface_detection) < 0)
         return MF_ERROR(MF_ERR_INTERNAL, "MPSCoeffs: a scheme choice outside its list");
     return 0;
 }
