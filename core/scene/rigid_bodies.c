@@ -413,13 +413,13 @@ static int reopen_at(mf_body *b, const char *path, double t, bool *kept)
     FILE *in = fopen(path, "r");
     if (!in)
         return 0;
-    char tmp[4500];
-    snprintf(tmp, sizeof tmp, "%s.tmp", path);
-    FILE *out = fopen(tmp, "w");
-    if (!out) {
+    mf_replace kept_rows;
+    int rc = mf_replace_open(&kept_rows, path, "w");
+    if (rc != 0) {
         fclose(in);
-        return MF_ERROR(MF_ERR_IO, "cannot write %s: %s", tmp, strerror(errno));
+        return mf_error_trace(rc, __FILE__, __LINE__, __func__);
     }
+    FILE *out = kept_rows.f;
     char line[4096];
     while (fgets(line, sizeof line, in)) {
         char *end;
@@ -429,8 +429,7 @@ static int reopen_at(mf_body *b, const char *path, double t, bool *kept)
             fputs(line, out);
     }
     fclose(in);
-    if (fclose(out) != 0 || rename(tmp, path) != 0)
-        return MF_ERROR(MF_ERR_IO, "cannot write %s: %s", path, strerror(errno));
+    MF_CALL(mf_replace_commit(&kept_rows, 0));
     b->csv = fopen(path, "a");
     if (!b->csv)
         return MF_ERROR(MF_ERR_IO, "cannot write %s: %s", path, strerror(errno));

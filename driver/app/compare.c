@@ -24,6 +24,7 @@
 
 #include "mf_dictio.h"
 #include "mf_error.h"
+#include "mf_fs.h"
 #include "mf_app.h"
 #include "mf_post.h"
 #include "mf_report.h"
@@ -58,27 +59,29 @@ static bool on_pareto_front(const compare_row *rows, size_t n, size_t i, bool cp
     return true;
 }
 
-static void write_report(const char *case_dir, compare_row *rows, size_t n)
+/* compare.csv (whole or not at all: a failed write is an error, not a
+ * table that silently ends early) and compare.png (a missing gnuplot is
+ * said and skipped: the table is the result). */
+static int write_report(const char *case_dir, compare_row *rows, size_t n)
 {
     char path[4400];
     snprintf(path, sizeof path, "%s/compare/compare.csv", case_dir);
-    FILE *f = fopen(path, "w");
-    if (f) {
-        fprintf(f, "# mpsflow compare of %s: error from validation/metric; pareto: on wall "
-                   "time, pareto_cpu: on CPU (user + system) time\n", case_dir);
-        /* New columns go at the end: scripts read the old ones by position. */
-        fprintf(f, "scheme,l0,particles,error,wall_seconds,steps,pressure_iterations,peak_MB,"
-                   "status,criterion,pareto,cpu_seconds,pareto_cpu\n");
-    }
+    mf_replace out;
+    MF_CALL(mf_replace_open(&out, path, "w"));
+    FILE *f = out.f;
+    fprintf(f, "# mpsflow compare of %s: error from validation/metric; pareto: on wall "
+               "time, pareto_cpu: on CPU (user + system) time\n", case_dir);
+    /* New columns go at the end: scripts read the old ones by position. */
+    fprintf(f, "scheme,l0,particles,error,wall_seconds,steps,pressure_iterations,peak_MB,"
+               "status,criterion,pareto,cpu_seconds,pareto_cpu\n");
     for (size_t i = 0; i < n; i++) {
         bool pareto = on_pareto_front(rows, n, i, false);
         bool pareto_cpu = on_pareto_front(rows, n, i, true);
-        if (f)
-            fprintf(f, "%s,%g,%ld,%.6g,%.4g,%ld,%ld,%.1f,%s,%s,%s,%.4g,%s\n", rows[i].scheme,
-                    rows[i].l0, rows[i].summary.particles, rows[i].error,
-                    rows[i].child.wall_seconds, rows[i].summary.steps, rows[i].summary.iterations,
-                    rows[i].child.peak_mb, rows[i].summary.status, rows[i].summary.criterion,
-                    pareto ? "yes" : "no", rows[i].child.cpu_seconds, pareto_cpu ? "yes" : "no");
+        fprintf(f, "%s,%g,%ld,%.6g,%.4g,%ld,%ld,%.1f,%s,%s,%s,%.4g,%s\n", rows[i].scheme,
+                rows[i].l0, rows[i].summary.particles, rows[i].error,
+                rows[i].child.wall_seconds, rows[i].summary.steps, rows[i].summary.iterations,
+                rows[i].child.peak_mb, rows[i].summary.status, rows[i].summary.criterion,
+                pareto ? "yes" : "no", rows[i].child.cpu_seconds, pareto_cpu ? "yes" : "no");
         if (pareto)
             printf("Pareto front: %s at l0 = %g (error %.4g, %.3g s)\n", rows[i].scheme,
                    rows[i].l0, rows[i].error, rows[i].child.wall_seconds);
@@ -86,8 +89,7 @@ static void write_report(const char *case_dir, compare_row *rows, size_t n)
             printf("Pareto front (CPU time): %s at l0 = %g (error %.4g, %.3g CPU s)\n",
                    rows[i].scheme, rows[i].l0, rows[i].error, rows[i].child.cpu_seconds);
     }
-    if (f)
-        fclose(f);
+    MF_CALL(mf_replace_commit(&out, 0));
     /* One line per scheme, points labelled by l0. */
     mf_series series[64];
     double xs[64][32], ys[64][32];
@@ -123,6 +125,7 @@ static void write_report(const char *case_dir, compare_row *rows, size_t n)
         fprintf(stderr, "%s\n", mf_error_message());
         mf_error_clear();
     }
+    return 0;
 }
 
 int mf_cmd_compare(mf_registry *reg, const mf_options *o)
@@ -192,7 +195,7 @@ int mf_cmd_compare(mf_registry *reg, const mf_options *o)
                    row->summary.iterations, row->child.peak_mb);
         }
     if (rc == 0)
-        write_report(case_dir, rows, n);
+        rc = write_report(case_dir, rows, n);
     if (rc == 0)
         printf("Table: %s/compare/compare.csv, plot: %s/compare/compare.png\n", case_dir,
                case_dir);

@@ -32,16 +32,15 @@ int mf_write_run_summary(const mf_app *app, int status)
     mf_parallel_sum_i64(sim0->par, &particles, 1);
     if (!mf_parallel_is_root(sim0->par))
         return 0;
-    char dir[4200], path[4300], tmp[4400], criterion[64];
+    char dir[4200], path[4300], criterion[64];
     snprintf(dir, sizeof dir, "%s/output", app->cs.dir);
     MF_CALL(mf_mkdir(dir));
     snprintf(path, sizeof path, "%s/runSummary", dir);
-    snprintf(tmp, sizeof tmp, "%s.tmp", path);
     const char *message = status ? mf_error_message() : "";
     criterion_of(message, criterion, sizeof criterion);
-    FILE *f = fopen(tmp, "w");
-    if (!f)
-        return MF_ERROR(MF_ERR_IO, "%s: cannot write (%s)", tmp, strerror(errno));
+    mf_replace out;
+    MF_CALL(mf_replace_open(&out, path, "w"));
+    FILE *f = out.f;
     const mf_sim *sim = &app->sim;
     /* Stopped before endTime on purpose: stopAt, or a signal. */
     const bool stopped = status == 0 && app->run.stop_reason[0] &&
@@ -75,7 +74,6 @@ int mf_write_run_summary(const mf_app *app, int status)
     fprintf(f, "pressureIterations  %ld;\n", sim->pressure_iterations);
     fprintf(f, "wallSeconds         %.6g;\n", app->run.wall_seconds);
     fprintf(f, "peakMemoryMB        %.6g;\n", mf_peak_memory() / 1048576.0);
-    if (fclose(f) != 0 || rename(tmp, path) != 0)
-        return MF_ERROR(MF_ERR_IO, "%s: cannot write (%s)", path, strerror(errno));
+    MF_CALL(mf_replace_commit(&out, 0));
     return 0;
 }

@@ -12,6 +12,7 @@
 
 #include "mf_dictio.h"
 #include "mf_error.h"
+#include "mf_fs.h"
 #include "mf_run.h"
 
 int mf_run_child(char *argv[], const char *log_path, mf_child_result *r)
@@ -82,19 +83,11 @@ int mf_dict_merge(mf_dict *dst, const mf_dict *src)
 
 int mf_dict_write_file(const mf_dict *d, const char *path, const char *comment)
 {
-    char tmp[4400];
-    if (snprintf(tmp, sizeof tmp, "%s.tmp", path) >= (int)sizeof tmp)
-        return MF_ERROR(MF_ERR_INPUT, "path too long: %s", path);
-    FILE *f = fopen(tmp, "w");
-    if (!f)
-        return MF_ERROR(MF_ERR_IO, "%s: cannot write (%s)", tmp, strerror(errno));
-    fprintf(f, "// %s\n", comment);
-    int rc = mf_dict_write(d, f, 0);
-    if (fclose(f) != 0 && rc == 0)
-        rc = MF_ERROR(MF_ERR_IO, "%s: write failed", tmp);
-    if (rc == 0 && rename(tmp, path) != 0)
-        rc = MF_ERROR(MF_ERR_IO, "%s: cannot rename (%s)", path, strerror(errno));
-    return rc;
+    mf_replace out;
+    MF_CALL(mf_replace_open(&out, path, "w"));
+    fprintf(out.f, "// %s\n", comment);
+    MF_CALL(mf_replace_commit(&out, mf_dict_write(d, out.f, 0)));
+    return 0;
 }
 
 void mf_read_run_summary(const char *run_dir, mf_run_summary *s)

@@ -114,19 +114,13 @@ static int parse(int argc, char **argv, int first, surface_opts *o)
 
 static int write_resolved(const char *dir, const mf_dict *resolved)
 {
-    char path[4500], tmp[4510];
+    char path[4500];
     snprintf(path, sizeof path, "%s/resolvedParameters", dir);
-    snprintf(tmp, sizeof tmp, "%s.tmp", path);
-    FILE *f = fopen(tmp, "w");
-    if (!f)
-        return MF_ERROR(MF_ERR_IO, "%s: cannot open for writing (%s)", tmp, strerror(errno));
-    fprintf(f, "// the parameters `mpsflow surface` used, defaults included\n");
-    int rc = mf_dict_write(resolved, f, 0);
-    if (fclose(f) != 0 && rc == 0)
-        rc = MF_ERROR(MF_ERR_IO, "%s: write failed", tmp);
-    if (rc == 0 && rename(tmp, path) != 0)
-        rc = MF_ERROR(MF_ERR_IO, "cannot rename %s to %s: %s", tmp, path, strerror(errno));
-    return rc;
+    mf_replace out;
+    MF_CALL(mf_replace_open(&out, path, "w"));
+    fprintf(out.f, "// the parameters `mpsflow surface` used, defaults included\n");
+    MF_CALL(mf_replace_commit(&out, mf_dict_write(resolved, out.f, 0)));
+    return 0;
 }
 
 static int run_surface(const surface_opts *o, mf_registry *reg, mf_log *log)

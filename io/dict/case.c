@@ -220,21 +220,15 @@ int mf_case_libs(const mf_case *c, const char ***libs, size_t *n)
 
 int mf_case_write_resolved(const mf_case *c)
 {
-    char dir[4200], path[4300], tmp[4400];
+    char dir[4200], path[4300];
     snprintf(dir, sizeof dir, "%s/output", c->dir);
     MF_CALL(mf_mkdir(dir));
     snprintf(path, sizeof path, "%s/resolvedParameters", dir);
-    snprintf(tmp, sizeof tmp, "%s.tmp", path);
-    FILE *f = fopen(tmp, "w");
-    if (!f)
-        return MF_ERROR(MF_ERR_IO, "%s: cannot write (%s)", tmp, strerror(errno));
-    fprintf(f, "// Parameters of this run as used, defaults included (written by mpsflow "
-               "%s).\n\n",
+    mf_replace out;
+    MF_CALL(mf_replace_open(&out, path, "w"));
+    fprintf(out.f, "// Parameters of this run as used, defaults included (written by mpsflow "
+                   "%s).\n\n",
             MPSFLOW_VERSION);
-    int rc = mf_dict_write(c->resolved, f, 0);
-    if (fclose(f) != 0 && rc == 0)
-        rc = MF_ERROR(MF_ERR_IO, "%s: write failed (%s)", tmp, strerror(errno));
-    if (rc == 0 && rename(tmp, path) != 0)
-        rc = MF_ERROR(MF_ERR_IO, "%s: cannot rename (%s)", path, strerror(errno));
-    return rc;
+    MF_CALL(mf_replace_commit(&out, mf_dict_write(c->resolved, out.f, 0)));
+    return 0;
 }

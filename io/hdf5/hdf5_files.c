@@ -98,37 +98,6 @@ int mf_h5_scan_snapshots(const char *output_dir, int **indices, size_t *n)
     return 0;
 }
 
-static int fsync_path(const char *path, int flags)
-{
-    int fd = open(path, flags);
-    if (fd < 0)
-        return MF_ERROR(MF_ERR_IO, "cannot open %s: %s", path, strerror(errno));
-    int rc = 0;
-    /* EINVAL: the file system does not sync this kind of file (some do not
-     * sync folders); nothing more we can do for durability there. */
-    if (fsync(fd) != 0 && errno != EINVAL)
-        rc = MF_ERROR(MF_ERR_IO, "cannot sync %s: %s", path, strerror(errno));
-    close(fd);
-    return rc;
-}
-
-int mf_h5_commit(const char *tmp, const char *final)
-{
-    MF_CALL(fsync_path(tmp, O_RDONLY));
-    if (rename(tmp, final) != 0)
-        return MF_ERROR(MF_ERR_IO, "cannot rename %s to %s: %s", tmp, final, strerror(errno));
-    char dir[MF_H5_PATH_MAX];
-    const char *slash = strrchr(final, '/');
-    if (!slash)
-        snprintf(dir, sizeof dir, ".");
-    else if ((size_t)(slash - final) < sizeof dir)
-        snprintf(dir, sizeof dir, "%.*s", slash == final ? 1 : (int)(slash - final), final);
-    else
-        return 0;
-    MF_CALL(fsync_path(dir, O_RDONLY | O_DIRECTORY));
-    return 0;
-}
-
 int mf_hdf5_latest_snapshot(const char *case_dir, char *path, size_t len, int *index)
 {
     char output_dir[MF_H5_PATH_MAX], candidate[MF_H5_PATH_MAX];

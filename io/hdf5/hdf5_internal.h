@@ -86,9 +86,6 @@ int mf_h5_snapshot_path(const char *output_dir, int index, char *buf, size_t len
 /* Indices of the files snapshot_<digits>.h5 in output_dir, ascending. A
  * missing folder is no snapshot. *indices is malloc'ed (NULL when n == 0). */
 int mf_h5_scan_snapshots(const char *output_dir, int **indices, size_t *n);
-/* fsync tmp, rename it to final, fsync the folder: the final name then
- * holds either the old or the complete new file, even after a power cut. */
-int mf_h5_commit(const char *tmp, const char *final);
 
 /* ---- hdf5_params.c ---------------------------------------------------- */
 

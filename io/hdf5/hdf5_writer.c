@@ -30,6 +30,7 @@
 #include "hdf5_internal.h"
 #include "mf_bodies.h"
 #include "mf_error.h"
+#include "mf_fs.h"
 #include "mf_hdf5.h"
 #include "mf_parallel_mpi.h"
 
@@ -565,7 +566,7 @@ int mf_hdf5_write_snapshot(const char *path, const mf_sim *sim, const mf_dict *p
     rc = mf_parallel_agree(sim->par, rc);
     const bool root = mf_parallel_is_root(sim->par);
     if (rc == 0 && root)
-        rc = mf_h5_commit(tmp, path);
+        rc = mf_rename_synced(tmp, path);
     if (rc != 0 && root)
         unlink(tmp); /* nothing half-written is left behind */
     rc = mf_parallel_agree(sim->par, rc);

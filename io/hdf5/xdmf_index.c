@@ -24,6 +24,7 @@
 #include "mf_alloc.h"
 #include "hdf5_internal.h"
 #include "mf_error.h"
+#include "mf_fs.h"
 #include "mf_hdf5.h"
 #include "mf_timetext.h"
 
@@ -336,18 +337,19 @@ static int select_lineage(const mf_xdmf_index *x, bool **keep)
 
 int mf_xdmf_index_write(const mf_xdmf_index *x, const char *output_dir)
 {
-    char path[MF_H5_PATH_MAX], tmp[MF_H5_PATH_MAX];
+    char path[MF_H5_PATH_MAX];
     int w1 = snprintf(path, sizeof path, "%s/particles.xdmf", output_dir);
-    int w2 = snprintf(tmp, sizeof tmp, "%s/particles.xdmf.tmp", output_dir);
-    if (w1 < 0 || w2 < 0 || (size_t)w2 >= sizeof tmp)
+    if (w1 < 0 || (size_t)w1 >= sizeof path)
         return MF_ERROR(MF_ERR_INPUT, "output path too long: %s", output_dir);
     bool *keep;
     MF_CALL(select_lineage(x, &keep));
-    FILE *f = fopen(tmp, "w");
-    if (!f) {
+    mf_replace out;
+    int rc = mf_replace_open(&out, path, "w");
+    if (rc != 0) {
         free(keep);
-        return MF_ERROR(MF_ERR_IO, "cannot write %s", tmp);
+        return mf_error_trace(rc, __FILE__, __LINE__, __func__);
     }
+    FILE *f = out.f;
     fputs("<?xml version=\"1.0\" ?>\n"
           "<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n"
           "<Xdmf Version=\"2.0\">\n"
@@ -362,16 +364,7 @@ int mf_xdmf_index_write(const mf_xdmf_index *x, const char *output_dir)
           "</Xdmf>\n",
           f);
     free(keep);
-    int failed = ferror(f);
-    if (fclose(f) != 0 || failed) {
-        remove(tmp);
-        return MF_ERROR(MF_ERR_IO, "cannot write %s (disk full?)", tmp);
-    }
-    int rc = mf_h5_commit(tmp, path);
-    if (rc != 0) {
-        remove(tmp);
-        return mf_error_trace(rc, __FILE__, __LINE__, __func__);
-    }
+    MF_CALL(mf_replace_commit(&out, 0));
     return 0;
 }
 

@@ -56,31 +56,11 @@ static float get_f32le(const uint8_t *p)
     return f;
 }
 
-/* Finish a file written under "<path>.tmp": close, check, rename. */
-static int finish(FILE *f, const char *tmp, const char *path, bool ok)
-{
-    if (fclose(f) != 0)
-        ok = false;
-    if (!ok) {
-        int e = errno;
-        remove(tmp);
-        return MF_ERROR(MF_ERR_IO, "%s: write failed (%s)", path, strerror(e));
-    }
-    if (rename(tmp, path) != 0) {
-        int e = errno;
-        remove(tmp);
-        return MF_ERROR(MF_ERR_IO, "cannot rename %s to %s: %s", tmp, path, strerror(e));
-    }
-    return 0;
-}
-
 int mf_mesh_write_ply(const char *path, const mf_mesh *m)
 {
-    char tmp[PATH_MAX_LEN];
-    snprintf(tmp, sizeof tmp, "%s.tmp", path);
-    FILE *f = fopen(tmp, "wb");
-    if (!f)
-        return MF_ERROR(MF_ERR_IO, "%s: cannot open for writing (%s)", tmp, strerror(errno));
+    mf_replace out;
+    MF_CALL(mf_replace_open(&out, path, "wb"));
+    FILE *f = out.f;
     bool ok = fprintf(f,
                       "ply\nformat binary_little_endian 1.0\ncomment mpsflow surface, time "
                       "%.17g\ncomment axes of the case: y is up (Blender, z up: "
@@ -116,16 +96,16 @@ int mf_mesh_write_ply(const char *path, const mf_mesh *m)
         }
         ok = fwrite(buf, 13, n, f) == n;
     }
-    return finish(f, tmp, path, ok);
+    (void)ok; /* a failed write leaves the stream's error flag: the commit sees it */
+    MF_CALL(mf_replace_commit(&out, 0));
+    return 0;
 }
 
 int mf_mesh_write_obj(const char *path, const mf_mesh *m)
 {
-    char tmp[PATH_MAX_LEN];
-    snprintf(tmp, sizeof tmp, "%s.tmp", path);
-    FILE *f = fopen(tmp, "w");
-    if (!f)
-        return MF_ERROR(MF_ERR_IO, "%s: cannot open for writing (%s)", tmp, strerror(errno));
+    mf_replace out;
+    MF_CALL(mf_replace_open(&out, path, "w"));
+    FILE *f = out.f;
     char *big = malloc(1 << 16); /* a large buffer: fprintf per line is the cost */
     if (big)
         setvbuf(f, big, _IOFBF, 1 << 16);
@@ -142,9 +122,12 @@ int mf_mesh_write_obj(const char *path, const mf_mesh *m)
              c = (long)m->tri[3 * t + 2] + 1;
         ok = fprintf(f, "f %ld//%ld %ld//%ld %ld//%ld\n", a, a, b, b, c, c) > 0;
     }
-    int rc = finish(f, tmp, path, ok);
+    (void)ok;
+    int rc = mf_replace_commit(&out, 0); /* before free: the buffer is the stream's */
     free(big);
-    return rc;
+    if (rc != 0)
+        return mf_error_trace(rc, __FILE__, __LINE__, __func__);
+    return 0;
 }
 
 /* ---- HDF5 --------------------------------------------------------------- */
@@ -201,8 +184,8 @@ int mf_mesh_write_h5(const char *path, const mf_mesh *m)
     if (file >= 0 && H5Fclose(file) < 0 && rc == 0)
         rc = MF_ERROR(MF_ERR_IO, "%s: cannot close", tmp);
     H5Eset_auto2(H5E_DEFAULT, func, cdata);
-    if (rc == 0 && rename(tmp, path) != 0)
-        rc = MF_ERROR(MF_ERR_IO, "cannot rename %s to %s: %s", tmp, path, strerror(errno));
+    if (rc == 0)
+        rc = mf_rename_synced(tmp, path);
     if (rc != 0)
         remove(tmp);
     return rc;
@@ -411,14 +394,15 @@ int mf_mesh_write_xdmf_index(const char *dir, const char *prefix)
         else
             fr[u++] = fr[k];
     }
-    char final[PATH_MAX_LEN], tmp[PATH_MAX_LEN + 8];
+    char final[PATH_MAX_LEN];
     snprintf(final, sizeof final, "%s/%s.xdmf", dir, prefix);
-    snprintf(tmp, sizeof tmp, "%s.tmp", final);
-    FILE *f = fopen(tmp, "w");
-    if (!f) {
+    mf_replace out;
+    int orc = mf_replace_open(&out, final, "w");
+    if (orc != 0) {
         free(fr);
-        return MF_ERROR(MF_ERR_IO, "%s: cannot open for writing (%s)", tmp, strerror(errno));
+        return mf_error_trace(orc, __FILE__, __LINE__, __func__);
     }
+    FILE *f = out.f;
     bool ok = fprintf(f,
                       "<?xml version=\"1.0\" ?>\n<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n"
                       "<!-- mpsflow surface meshes: open in ParaView next to "
@@ -449,9 +433,11 @@ int mf_mesh_write_xdmf_index(const char *dir, const char *prefix)
                      prefix, fr[k].index, time, fr[k].ntris, fr[k].ntris, file,
                      fr[k].nverts, file, fr[k].nverts, file) > 0;
     }
-    ok = ok && fprintf(f, "  </Grid>\n </Domain>\n</Xdmf>\n") > 0;
+    if (ok)
+        fprintf(f, "  </Grid>\n </Domain>\n</Xdmf>\n");
     free(fr);
-    return finish(f, tmp, final, ok);
+    MF_CALL(mf_replace_commit(&out, 0));
+    return 0;
 }
 
 int mf_mesh_write_frame(const char *dir, const char *prefix, int index, const mf_mesh *m,

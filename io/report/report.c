@@ -8,15 +8,14 @@
 #include <sys/wait.h>
 
 #include "mf_error.h"
+#include "mf_fs.h"
 
 int mf_report_csv(const char *path, const char *comment, const char *header, size_t ncols,
                   const double *const *columns, size_t nrows)
 {
-    char tmp[4200];
-    snprintf(tmp, sizeof tmp, "%s.tmp", path);
-    FILE *f = fopen(tmp, "w");
-    if (!f)
-        return MF_ERROR(MF_ERR_IO, "%s: cannot write (%s)", tmp, strerror(errno));
+    mf_replace out;
+    MF_CALL(mf_replace_open(&out, path, "w"));
+    FILE *f = out.f;
     if (comment) {
         const char *s = comment;
         while (*s) {
@@ -29,10 +28,7 @@ int mf_report_csv(const char *path, const char *comment, const char *header, siz
     for (size_t r = 0; r < nrows; r++)
         for (size_t c = 0; c < ncols; c++)
             fprintf(f, "%.10g%s", columns[c][r], c + 1 < ncols ? "," : "\n");
-    if (fclose(f) != 0)
-        return MF_ERROR(MF_ERR_IO, "%s: write failed (%s)", tmp, strerror(errno));
-    if (rename(tmp, path) != 0)
-        return MF_ERROR(MF_ERR_IO, "%s: cannot rename (%s)", path, strerror(errno));
+    MF_CALL(mf_replace_commit(&out, 0));
     return 0;
 }
 

@@ -146,9 +146,9 @@ static int final_evaluate(const void *settings, const mf_metric_ctx *ctx, double
     MF_CALL(ctx->snapshots(ctx, &idx, &n));
     char path[4600];
     snprintf(path, sizeof path, "%s/result.csv", ctx->out_dir);
-    FILE *out = fopen(path, "w");
-    int rc = out ? 0 : MF_ERROR(MF_ERR_IO, "%s: cannot open for writing (%s)", path,
-                                strerror(errno));
+    mf_replace result; /* written whole or not at all (mf_fs.h) */
+    int rc = mf_replace_open(&result, path, "w");
+    FILE *out = result.f;
     if (rc == 0 && n == 0)
         rc = MF_ERROR(MF_ERR_INPUT, "%s: no snapshot to score", ctx->case_dir);
     if (rc == 0)
@@ -166,8 +166,8 @@ static int final_evaluate(const void *settings, const mf_metric_ctx *ctx, double
         }
         mf_particles_destroy(snap.p);
     }
-    if (out && fclose(out) != 0 && rc == 0)
-        rc = MF_ERROR(MF_ERR_IO, "%s: write failed", path);
+    if (out)
+        rc = mf_replace_commit(&result, rc);
     free(idx);
     return rc;
 }
