@@ -326,6 +326,10 @@ int mps_lagrangian_step(mps_data *d, mf_sim *sim, double dt);
  * dictionary); the work arrays the scheme needs; its log line. */
 int mps_scheme_resolve(const mps_settings *s, int dim, mps_scheme *out);
 int mps_scheme_reserve(mps_data *d, size_t n);
+/* The scheme's work arrays' pages given back across the pressure solve
+ * (mf_release_pages): n_start, rate_start, src and work are rewritten in
+ * the next step before they are read. Returns the bytes released. */
+size_t mps_scheme_release(mps_data *d);
 void mps_scheme_free(mps_data *d);
 void mps_scheme_log(const mps_data *d, mf_log *log);
 

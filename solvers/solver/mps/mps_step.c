@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_alloc.h"
 #include "mf_error.h"
 #include "mf_lsmps.h"
 #include "mf_operators.h"
@@ -282,12 +283,29 @@ static int run_before_assembly(mps_data *d, mf_sim *sim)
     return 0;
 }
 
+/* The step's scratch that is dead across the pressure solve, its pages
+ * given back (mf_release_pages) so that the solve's peak (the AMG set-up's
+ * matrices) does not stack on them; each is rewritten before it is read
+ * again. grad: the correction's gradient (and the collision's new
+ * velocities) write it first; worst_row (mps_ppe.c) writes the part it uses.
+ * acc: zeroed at the next explicit phase, but wallPressureExtrapolated
+ * without wall weight reads it in the correction (mps_wall_pressure.c),
+ * so there it is kept. The scheme's arrays: mps_scheme_release. */
+static void release_dead_scratch(mps_data *d)
+{
+    (void)mf_release_pages(d->grad, 3 * d->cap * sizeof *d->grad);
+    if (!(d->s.wall_pressure_extrapolated && !d->wall))
+        (void)mf_release_pages(d->acc, 3 * d->cap * sizeof *d->acc);
+    (void)mps_scheme_release(d);
+}
+
 /* eqs. 11-14 and 18: number density at r*, free surface, PPE. */
 int mps_pressure_phase(mps_data *d, mf_sim *sim, double dt)
 {
     MF_CALL(mps_surface_phase(d, sim));
     MF_CALL(run_before_assembly(d, sim));
     MF_CALL(mps_assemble_ppe(d, sim, dt));
+    release_dead_scratch(d);
     MF_CALL(mps_solve_ppe(d, sim));
     return 0;
 }
