@@ -157,7 +157,7 @@ int mps_scheme_reserve(mps_data *d, size_t n)
  * the unknowns the assembly reads, work by whichever phase uses it as
  * scratch (asymmetry, divergence, p^, the walls' extrapolated p, shifting).
  * A retry starts the step again from the explicit phase. */
-size_t mps_scheme_release(mps_data *d)
+size_t mps_scheme_release(mps_data *d, bool with_src)
 {
     const size_t cap = d->cap_scheme;
     size_t released = 0;
@@ -165,7 +165,7 @@ size_t mps_scheme_release(mps_data *d)
         released += mf_release_pages(d->n_start, cap * sizeof *d->n_start);
     if (d->rate_start)
         released += mf_release_pages(d->rate_start, cap * sizeof *d->rate_start);
-    if (d->src)
+    if (d->src && with_src)
         released += mf_release_pages(d->src, cap * sizeof *d->src);
     if (d->work)
         released += mf_release_pages(d->work, work_width(&d->sc) * cap * sizeof *d->work);
