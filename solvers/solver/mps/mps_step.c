@@ -144,20 +144,6 @@ static void release_step_scratch(mps_data *d)
         (void)mf_release_pages(d->acc, 3 * d->cap * sizeof *d->acc);
 }
 
-/* The last step's pressure matrix is dead from the end of its solve to the
- * next assembly, which writes every entry it uses (mf_pairs_row_assemble,
- * ppe_row) before the solve reads them; the pressure module keeps nothing
- * of it between solves (its V-cycle splits the fine matrix again at each
- * solve, amg_vcycle.c). Its columns and values, the largest arrays of a
- * run, given back while the explicit phase and the lists at r* are built,
- * so that those do not stack on them. rowptr, rhs and x stay (small; the
- * log's row counts read rowptr). */
-static void release_last_matrix(mps_data *d)
-{
-    (void)mf_release_pages(d->A.col, d->cap_nnz * sizeof *d->A.col);
-    (void)mf_release_pages(d->A.val, d->cap_nnz * sizeof *d->A.val);
-}
-
 /* eqs. 9-10: u* = u + dt (nu lap u + forces), r* = r + dt u*. With a
  * density and viscosity per particle (mps_data.mu), eq. 27: each particle's
  * own nu, pairs of unlike particles through mu_ij. */
@@ -165,7 +151,6 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
 {
     double t0 = mf_wall_seconds();
     d->attempts++;
-    release_last_matrix(d);
     mf_particles *p = sim->p;
     const double nu = sim->fluid[0].nu;
     retry_scale(d, sim, dt);
