@@ -1,9 +1,11 @@
-/* alloc.c: mf_resize (mf_alloc.h). */
+/* alloc.c: mf_resize, mf_release_pages (mf_alloc.h). */
 #include "mf_alloc.h"
 
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
+#include <unistd.h>
 
 #include "mf_error.h"
 
@@ -19,4 +21,23 @@ int mf_resize(void *pp, size_t n, size_t elem)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory (%zu elements of %zu bytes)", n, elem);
     memcpy(pp, &grown, sizeof grown);
     return 0;
+}
+
+size_t mf_release_pages(void *ptr, size_t bytes)
+{
+    if (!ptr || bytes < MF_RELEASE_MIN_BYTES)
+        return 0;
+    const long ps = sysconf(_SC_PAGESIZE);
+    if (ps <= 0)
+        return 0;
+    const uintptr_t page = (uintptr_t)ps, start = (uintptr_t)ptr;
+    const uintptr_t first = (start + page - 1) / page * page; /* whole pages only */
+    const uintptr_t end = (start + bytes) / page * page;
+    if (end <= first)
+        return 0;
+    /* Linux: private anonymous pages (the heap, malloc's mmapped blocks)
+     * read as zero-filled pages after MADV_DONTNEED (madvise(2)). */
+    if (madvise((void *)first, end - first, MADV_DONTNEED) != 0)
+        return 0;
+    return end - first;
 }

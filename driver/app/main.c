@@ -17,6 +17,7 @@
 #include "mf_app.h"
 #include "mf_bodies.h"
 #include "mf_error.h"
+#include "mf_malloc_defaults.h"
 #include "mf_post.h"
 #include "mf_walls.h"
 
@@ -346,6 +347,9 @@ static void hwloc_without_displays(void)
 
 int main(int argc, char **argv)
 {
+    /* Freed memory goes back to the system again: libsuperlu_dist's
+     * constructor turned that off before main (malloc_defaults.c). */
+    (void)mf_malloc_gives_back();
     hwloc_without_displays();
     openmp_wait_policy(argv);
     /* Whole lines reach a redirected log at once (tail -f, a kill). */

@@ -1,8 +1,7 @@
-/* mesh_import.c: polygon files through assimp's C API (assimp/cimport.h). */
+/* mesh_import.c: polygon files through assimp's C API (assimp/cimport.h),
+ * loaded on first use (mf_assimp_load.h). */
 #include "mf_mesh_import.h"
 
-#include <assimp/cimport.h>
-#include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <errno.h>
 #include <inttypes.h>
@@ -12,6 +11,7 @@
 #include <strings.h>
 #include <sys/stat.h>
 
+#include "mf_assimp_load.h"
 #include "mf_error.h"
 
 /* Vertices of one assimp mesh, through the node's accumulated transform
@@ -141,16 +141,18 @@ int mf_mesh_import(const char *path, mf_trimesh *out)
      * bad face line). Polygons are split here instead (add_mesh, which also
      * checks every index), corners merged by mf_trimesh_weld; points and
      * lines are counted, and refused by the scene builder. */
-    const struct aiScene *sc = aiImportFile(path, 0);
+    const mf_assimp_api *ai;
+    MF_CALL(mf_assimp_load(path, &ai));
+    const struct aiScene *sc = ai->import_file(path, 0);
     if (!sc)
         return MF_ERROR(MF_ERR_INPUT, "%s: not a polygon file assimp can read (%s)", path,
-                        aiGetErrorString());
+                        ai->get_error_string());
     int rc = 0;
     if (sc->mRootNode) {
         struct aiMatrix4x4 id = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
         rc = add_node(out, sc, sc->mRootNode, &id, 0);
     }
-    aiReleaseImport(sc);
+    ai->release_import(sc);
     MF_CALL(rc);
     if (out->ntris == 0)
         return MF_ERROR(MF_ERR_INPUT, "%s: holds no triangle or polygon (%zu vertices, %zu points "

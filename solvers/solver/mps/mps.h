@@ -326,6 +326,11 @@ int mps_lagrangian_step(mps_data *d, mf_sim *sim, double dt);
  * dictionary); the work arrays the scheme needs; its log line. */
 int mps_scheme_resolve(const mps_settings *s, int dim, mps_scheme *out);
 int mps_scheme_reserve(mps_data *d, size_t n);
+/* The scheme's work arrays' pages given back (mf_release_pages) once they
+ * are dead for the step: n_start, rate_start and work once the source is
+ * made (mps_source_terms), src too (with_src) once the matrix is. Each is
+ * rewritten in the next step before it is read. Returns the bytes released. */
+size_t mps_scheme_release(mps_data *d, bool with_src);
 void mps_scheme_free(mps_data *d);
 void mps_scheme_log(const mps_data *d, mf_log *log);
 

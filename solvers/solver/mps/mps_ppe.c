@@ -302,6 +302,10 @@ int mps_assemble_ppe(mps_data *d, const mf_sim *sim, double dt)
     int rc = d->n_offset ? 0 : mps_source_terms(d, sim, dt);
     if (rc == 0 && d->sc.source != MPS_SOURCE_DENSITY && !d->n_offset)
         c.src = d->src;
+    /* What the source was made of (n_start, rate_start, work) is dead until
+     * the next step: its pages given back before the matrix is written. */
+    if (rc == 0)
+        (void)mps_scheme_release(d, false);
     if (d->sc.laplacian != MPS_LAPLACIAN_PAPER) { /* higherOrder, and leastSquares' PPE */
         c.hl = true;
         c.c = d->k_lap.hl_coef;

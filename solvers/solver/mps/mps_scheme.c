@@ -40,6 +40,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_alloc.h"
 #include "mf_error.h"
 #include "mps.h"
 
@@ -119,6 +120,13 @@ static int grow(void **p, size_t n, size_t size)
     return 0;
 }
 
+/* 3n for a vector (the surface's asymmetry); shifting adds a normal and
+ * a velocity gradient (3 + 3 + 9, mps_shift.c). */
+static size_t work_width(const mps_scheme *sc)
+{
+    return sc->shifting == MPS_SHIFT_NONE ? 3 : 15;
+}
+
 int mps_scheme_reserve(mps_data *d, size_t n)
 {
     if (n <= d->cap_scheme)
@@ -134,9 +142,7 @@ int mps_scheme_reserve(mps_data *d, size_t n)
         rc |= grow((void **)&d->rate_start, cap, sizeof *d->rate_start);
     if (sc->source != MPS_SOURCE_DENSITY)
         rc |= grow((void **)&d->src, cap, sizeof *d->src);
-    /* 3n for a vector (the surface's asymmetry); shifting adds a normal and
-     * a velocity gradient (3 + 3 + 9, mps_shift.c). */
-    const size_t width = sc->shifting == MPS_SHIFT_NONE ? 3 : 15;
+    const size_t width = work_width(sc);
     rc |= grow((void **)&d->work, width * cap, sizeof *d->work);
     rc |= grow((void **)&d->flag_work, cap, sizeof *d->flag_work);
     if (rc)
@@ -144,6 +150,26 @@ int mps_scheme_reserve(mps_data *d, size_t n)
                         n);
     d->cap_scheme = cap;
     return 0;
+}
+
+/* Each is written before it is read in a step: n_start and rate_start at
+ * r^n (mps_source_start, or the viscous pass), src by mps_source_terms for
+ * the unknowns the assembly reads, work by whichever phase uses it as
+ * scratch (asymmetry, divergence, p^, the walls' extrapolated p, shifting).
+ * A retry starts the step again from the explicit phase. */
+size_t mps_scheme_release(mps_data *d, bool with_src)
+{
+    const size_t cap = d->cap_scheme;
+    size_t released = 0;
+    if (d->n_start)
+        released += mf_release_pages(d->n_start, cap * sizeof *d->n_start);
+    if (d->rate_start)
+        released += mf_release_pages(d->rate_start, cap * sizeof *d->rate_start);
+    if (d->src && with_src)
+        released += mf_release_pages(d->src, cap * sizeof *d->src);
+    if (d->work)
+        released += mf_release_pages(d->work, work_width(&d->sc) * cap * sizeof *d->work);
+    return released;
 }
 
 void mps_scheme_free(mps_data *d)

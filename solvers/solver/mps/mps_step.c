@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mf_alloc.h"
 #include "mf_error.h"
 #include "mf_lsmps.h"
 #include "mf_operators.h"
@@ -127,6 +128,22 @@ static void retry_scale(mps_data *d, const mf_sim *sim, double dt)
     d->density_scale = 1.0;
 }
 
+/* grad and acc are dead from the end of the explicit phase to the
+ * correction: their pages given back (mf_release_pages) so that the lists
+ * at r*, the assembly and the solve do not stack on them; each is rewritten
+ * before it is read again. grad: the correction's gradient (and the
+ * collision's new velocities) write it first; worst_row (mps_ppe.c) writes
+ * the part it uses; the multi-fluid rounds write it before they read it.
+ * acc: zeroed at the next explicit phase, but wallPressureExtrapolated
+ * without wall weight reads it in the correction (mps_wall_pressure.c),
+ * so there it is kept. */
+static void release_step_scratch(mps_data *d)
+{
+    (void)mf_release_pages(d->grad, 3 * d->cap * sizeof *d->grad);
+    if (!(d->s.wall_pressure_extrapolated && !d->wall))
+        (void)mf_release_pages(d->acc, 3 * d->cap * sizeof *d->acc);
+}
+
 /* eqs. 9-10: u* = u + dt (nu lap u + forces), r* = r + dt u*. With a
  * density and viscosity per particle (mps_data.mu), eq. 27: each particle's
  * own nu, pairs of unlike particles through mu_ij. */
@@ -189,6 +206,7 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
         MF_CALL(collide(d, sim, dt));
     if (d->s.collision && d->wall)
         MF_CALL(mps_wall_collide(d, sim, dt));
+    release_step_scratch(d);
     d->t_explicit += mf_wall_seconds() - t0;
     return 0;
 }
@@ -288,6 +306,10 @@ int mps_pressure_phase(mps_data *d, mf_sim *sim, double dt)
     MF_CALL(mps_surface_phase(d, sim));
     MF_CALL(run_before_assembly(d, sim));
     MF_CALL(mps_assemble_ppe(d, sim, dt));
+    /* The scheme's source is dead until the next step too (the rest was
+     * released in the assembly): its pages given back, so that the solve's
+     * peak (the AMG set-up) does not stack on them. */
+    (void)mps_scheme_release(d, true);
     MF_CALL(mps_solve_ppe(d, sim));
     return 0;
 }
