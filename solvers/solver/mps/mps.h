@@ -442,6 +442,12 @@ void mps_wall_keep_forces(mps_data *d, const mf_sim *sim);
 void mps_wall_keep_approach(mps_data *d, const mf_sim *sim, double dt);
 void mps_wall_number_density(const mps_data *d, const mf_sim *sim, double *n);
 void mps_wall_viscous(mps_data *d, const mf_sim *sim, double nu);              /* into d->acc */
+/* eq. 7's wall term only where mask is set (the LSMPS fit's fallbacks). */
+void mps_wall_viscous_where(mps_data *d, const mf_sim *sim, double nu, const uint8_t *mask);
+/* laplacian leastSquares: nu <lap u> into d->acc by LSMPS with the walls'
+ * virtual points in each fit (plane faces); failed as mf_lsmps_laplacian_add. */
+size_t mps_wall_lsmps_laplacian(mps_data *d, const mf_sim *sim, const mf_pairs *v, double nu,
+                                uint8_t *failed);
 void mps_wall_divergence(const mps_data *d, const mf_sim *sim, const uint8_t *imask,
                          double *div);
 /* Into d->grad; phat: p^ of eq. 5 (the neighbourhood's minimum or p). */
