@@ -243,7 +243,7 @@ void mps_wall_viscous(mps_data *d, const mf_sim *sim, double nu)
 /* The walls' virtual points in particle i's LSMPS fit (mf_lsmps_extra_fn):
  * every lattice point of every solid within reach (mf_wall_points_each,
  * the lattice the wall weight tables sum over), carrying the no-slip
- * velocity continued through the face,
+ * velocity continued through the face (mf_wall_noslip_factor),
  *   u_v = u_w - (s_v / d)(u_i - u_w) = 2 u_w - u_m,
  * s_v the point's depth behind the face, d the particle's distance to it
  * (at least l0/4, as mf_wall_sums.visc), u_m the velocity at the point's
@@ -269,8 +269,7 @@ typedef struct ls_point_ctx {
 static void ls_point(void *ctx, const double r[3], double depth, double dist, double sign)
 {
     const ls_point_ctx *pc = ctx;
-    const double d = dist > pc->d_min ? dist : pc->d_min;
-    const double phi = 1.0 + depth / d; /* (u_v - u_i) / (u_w - u_i) */
+    const double phi = mf_wall_noslip_factor(depth, dist, pc->d_min);
     const double df[3] = {phi * pc->du[0], phi * pc->du[1], phi * pc->du[2]};
     pc->add(pc->acc, r, df, sign);
 }
