@@ -244,7 +244,8 @@ extern const char *const mps_scheme_choices[], *const mps_source_choices[],
      "leastSquares (LSMPS, Tamai & Koshizuka 2014)"},                                           \
     {"laplacian", MF_PARAM_WORD, "scheme", MF_NO_RANGE, mps_laplacian_choices, OFF(laplacian), \
      "Laplacian: paper (eq. 7), higherOrder (Khayyer & Gotoh 2010), leastSquares (LSMPS in "    \
-     "the viscous term, higherOrder in the pressure equation)"},                                \
+     "the viscous term, higherOrder in the pressure equation; with wall wallWeight the walls' " \
+     "virtual points enter each fit, tank and box solids only)"},                               \
     {"shifting", MF_PARAM_WORD, "scheme", MF_NO_RANGE, mps_shifting_choices, OFF(shifting),    \
      "particle shifting: none, fickian (Lind et al. 2012; tangential at the free surface)"},   \
     {"shiftCoefficient", MF_PARAM_SCALAR, "0.05", 0, 1, NULL, OFF(shift_coefficient),          \
