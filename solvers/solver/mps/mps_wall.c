@@ -11,7 +11,7 @@
  *     (mps_wall_keep_approach),
  *   the viscous term (eq. 7) with no slip on the face at the wall's velocity,
  *     or under `laplacian leastSquares;` the walls' virtual points in each
- *     particle's LSMPS fit (mps_wall_ls_points: tanks and boxes only),
+ *     particle's LSMPS fit (mps_wall_lsmps_laplacian: tanks and boxes only),
  *   the collision model against the face.
  * The scene is then built without wall and dummy particles (the driver
  * reads the key before it builds the scene: sim->wall_weight). Each phase
