@@ -98,7 +98,13 @@ static void extra(const void *ctx, size_t i, mf_lsmps_point_fn add, void *acc)
 {
     const wall_ctx *w = ctx;
     point_ctx pc = {w, &w->p->pos[3 * i], &w->u[3 * i], add, acc};
-    CHECK(mf_wall_points_each(w->wall, w->tables, w->dim, L0, RE, pc.x, point, &pc));
+    mf_wall_points_each(w->wall, w->tables, w->dim, L0, RE, pc.x, point, &pc);
+}
+
+static void count_point(void *ctx, const double r[3], double depth, double dist, double sign)
+{
+    (void)r, (void)depth, (void)dist, (void)sign;
+    (*(size_t *)ctx)++;
 }
 
 /* layers of fluid above the wall; the largest error of <lap u> over the
@@ -141,6 +147,11 @@ static size_t run(int dim, int layers, bool quadratic, int values, bool with_wal
     CHECK_OK(mf_grid_build(&g, p, RE));
     CHECK_OK(mf_nlist_build(&nl, &g, p, RE));
     const mf_pairs v = mf_pairs_of_list(p, &nl, RE);
+    /* a plane-faced solid gives its points (extra() runs on the engine's
+     * threads, where CHECK's counter is not safe) */
+    size_t npts = 0;
+    CHECK(mf_wall_points_each(&tank, t, dim, L0, RE, &p->pos[0], count_point, &npts));
+    CHECK(npts > 0);
     const wall_ctx w = {&tank, t, p, u, dim, values, quadratic};
     mf_lsmps_laplacian_add_extra(&v, &k, u, 1.0, NULL, NULL, with_wall ? extra : NULL, &w, out,
                                  failed);

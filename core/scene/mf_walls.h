@@ -227,8 +227,8 @@ bool mf_walls_sums(const mf_walls *ws, const mf_wall_tables *t, const double x[3
 bool mf_wall_sums_of(const mf_wall *w, const mf_wall_tables *t, int dim, double l0,
                      const double x[3], mf_wall_sums *s);
 
-/* The virtual points of one solid made of plane faces (tank, box) within R
- * of x: each point of each term of its expansion (the lattice of
+/* The virtual points of one solid made of plane faces (tank, box) closer
+ * than R to x: each point of each term of its expansion (the lattice of
  * mf_wall_lattice.h, in the body axes) as fn(ctx, r, depth, dist, sign),
  * r the offset from x in the world frame, depth the point's distance
  * behind the nearest of its term's planes (s_v), dist the particle's

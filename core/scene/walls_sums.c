@@ -294,6 +294,7 @@ typedef struct points_ctx {
     const mf_wall_term *tm;
     const double *R; /* body to world */
     int dim, free_axis[3];
+    double R2; /* points at R or farther are left out */
     mf_wall_point_fn fn;
     void *ctx;
 } points_ctx;
@@ -302,6 +303,8 @@ static void term_point(void *ctx, const double v[3])
 {
     const points_ctx *pc = ctx;
     const mf_wall_term *tm = pc->tm;
+    if (!(v[0] * v[0] + v[1] * v[1] + v[2] * v[2] < pc->R2))
+        return;
     double b[3] = {0, 0, 0};
     double depth = INFINITY, dist = 0;
     for (int k = 0; k < tm->c; k++) {
@@ -339,7 +342,8 @@ bool mf_wall_points_each(const mf_wall *w, const mf_wall_tables *t, int dim, dou
                                              : box_terms(w, t, dim, xb, terms);
     for (int k = 0; k < nt; k++) {
         const mf_wall_term *tm = &terms[k];
-        points_ctx pc = {.tm = tm, .R = w->state.R, .dim = dim, .fn = fn, .ctx = ctx};
+        points_ctx pc = {.tm = tm, .R = w->state.R, .dim = dim, .R2 = R * R, .fn = fn,
+                         .ctx = ctx};
         int nfree = 0;
         for (int a = 0; a < dim; a++) { /* the body axes no constrained axis takes */
             bool used = false;
