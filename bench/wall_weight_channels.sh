@@ -3,8 +3,11 @@
 # solvers/solver/mps/mps_wall.c) on the channel tutorials: poiseuille2D and
 # couette2D at l0 = H/10, H/20, H/40 (0.01, 0.005, 0.0025 m), scored by
 # their `validate` metric (relative RMS error of u against the series
-# solution at t = 1 s), with the observed order between spacings.
+# solution at t = 1 s), with the observed order between spacings. Variants:
+# particles, wallWeight (eq. 7's wall term), wallWeightLS (wall wallWeight
+# with laplacian leastSquares: the walls' virtual points in each LSMPS fit).
 #   bench/wall_weight_channels.sh            # both cases, three spacings
+#   CASES=couette2D L0S=0.00125 WALLS=wallWeightLS CSV=couette_h80.csv bench/wall_weight_channels.sh
 #   CASES=couette2D L0S='0.01 0.005' bench/wall_weight_channels.sh
 #   WALLS=wallWeight MAXDI=0.025 bench/wall_weight_channels.sh   # a quarter of the step
 # Two runs at a time, one thread each; writes bench/results/wall_weight_channels.csv.
@@ -14,16 +17,20 @@ MPSFLOW=${MPSFLOW:-$PWD/build/driver/mpsflow}
 export OMP_NUM_THREADS=1
 cases=${CASES:-poiseuille2D couette2D}
 l0s=${L0S:-0.01 0.005 0.0025}
-walls=${WALLS:-particles wallWeight}
+walls=${WALLS:-particles wallWeight wallWeightLS}
 out=bench/results; mkdir -p "$out"
-csv=$out/wall_weight_channels.csv
+csv=$out/${CSV:-wall_weight_channels.csv}
 work=$(mktemp -d)
 [ -n "$KEEP" ] || trap 'rm -rf "$work"' EXIT
 
 one() { # CASE WALL L0
     d=$work/$1_$2_$3
     cp -r "tutorials/$1" "$d"
-    sed -i "/^MPSCoeffs/,/^}/ s/^}\$/    wall $2;\n}/" "$d/system/solverDict"
+    case $2 in
+    wallWeightLS) keys='    wall wallWeight;\n    laplacian leastSquares;' ;;
+    *) keys="    wall $2;" ;;
+    esac
+    sed -i "/^MPSCoeffs/,/^}/ s/^}\$/$keys\n}/" "$d/system/solverDict"
     # the explicit viscous limit nu dt / l0^2 (the tutorials' 0.1; it sets dt ~ l0^2)
     [ -z "$MAXDI" ] || sed -i "s/^maxDi .*/maxDi $MAXDI;/" "$d/system/controlDict"
     t0=$(date +%s.%N)

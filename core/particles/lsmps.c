@@ -21,11 +21,14 @@ typedef struct {
     double scale;
     double *out;
     uint8_t *failed;
+    mf_lsmps_extra_fn extra; /* extra points of each fit (NULL: none) */
+    const void *extra_ctx;
 } ls_ctx;
 
 typedef struct {
     double m[LS_MAX][LS_MAX]; /* lower triangle used */
     double b[LS_MAX][LS_COMP];
+    const ls_ctx *c; /* for the extra points */
 } ls_acc;
 
 /* The basis at x (scaled): the linear terms, then the quadratic ones. */
@@ -73,6 +76,27 @@ static inline bool ls_pair(void *acc, const void *ctx, const mf_pair *pr, int nc
             a->b[r][q] += w * p[r] * df;
     }
     return true;
+}
+
+/* One extra point (mf_lsmps_point_fn) into M and b, as a pair at r with
+ * field difference df, times sign. */
+static void ls_extra_point(void *acc, const double r[3], const double df[3], double sign)
+{
+    ls_acc *a = acc;
+    const ls_ctx *c = a->c;
+    const double len = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+    const double w = sign * mf_weight_ls(len, c->v->radius);
+    if (w == 0.0)
+        return;
+    const double x[3] = {r[0] * c->inv_l0, r[1] * c->inv_l0, r[2] * c->inv_l0};
+    double p[LS_MAX];
+    const int nb = ls_basis(c->dim, x, p);
+    for (int q = 0; q < nb; q++)
+        for (int s = 0; s <= q; s++)
+            a->m[q][s] += w * p[q] * p[s];
+    for (int q = 0; q < LS_COMP; q++)
+        for (int s = 0; s < nb; s++)
+            a->b[s][q] += w * p[s] * df[q];
 }
 
 static inline bool ls1_pair(void *acc, const void *ctx, const mf_pair *pr)
@@ -146,6 +170,10 @@ static void lap_row(const void *ctx, size_t i)
     ls_acc a;
     memset(&a, 0, sizeof a);
     mf_pairs_row(c->v, i, c->jmask, ls3_pair, c, &a);
+    if (c->extra) {
+        a.c = c;
+        c->extra(c->extra_ctx, i, ls_extra_point, &a);
+    }
     double x[LS_MAX][LS_COMP];
     if (!ls_solve(&a, c->nb, 3, x)) {
         c->failed[i] = 1;
@@ -187,9 +215,17 @@ size_t mf_lsmps_laplacian_add(const mf_pairs *v, const mf_kernel *k, const doubl
                               double scale, const uint8_t *imask, const uint8_t *jmask,
                               double *out, uint8_t *failed)
 {
+    return mf_lsmps_laplacian_add_extra(v, k, u, scale, imask, jmask, NULL, NULL, out, failed);
+}
+
+size_t mf_lsmps_laplacian_add_extra(const mf_pairs *v, const mf_kernel *k, const double *u,
+                                    double scale, const uint8_t *imask, const uint8_t *jmask,
+                                    mf_lsmps_extra_fn extra, const void *extra_ctx, double *out,
+                                    uint8_t *failed)
+{
     const ls_ctx c = {.v = v, .jmask = jmask, .f = u, .dim = k->dim,
                       .nb = k->dim == 2 ? 5 : 9, .inv_l0 = 1.0 / k->l0, .scale = scale,
-                      .out = out, .failed = failed};
+                      .out = out, .failed = failed, .extra = extra, .extra_ctx = extra_ctx};
     mf_pairs_each(v, imask, lap_row, &c);
     return count_failed(v, imask, failed);
 }

@@ -38,4 +38,23 @@ size_t mf_lsmps_laplacian_add(const mf_pairs *v, const mf_kernel *k, const doubl
                               double scale, const uint8_t *imask, const uint8_t *jmask,
                               double *out, uint8_t *failed);
 
+/* Points beyond the particles in a fit: a wall's virtual points (mps_wall.c,
+ * on the lattice of mf_wall_lattice.h). The caller's extra(ctx, i, add, acc)
+ * calls add(acc, r, df, sign) once per point of particle i: r its offset
+ * from the particle (m), df = f_v - f_i its field difference (3
+ * components), sign +1 or -1 (the inclusion-exclusion of a box's faces,
+ * edges and corners, mf_wall_weight.h); the point enters M_i and b_i with
+ * the weight of a particle at r, times sign. extra is called from the pair
+ * engine's threads: it must only read shared data. */
+typedef void (*mf_lsmps_point_fn)(void *acc, const double r[3], const double df[3],
+                                  double sign);
+typedef void (*mf_lsmps_extra_fn)(const void *ctx, size_t i, mf_lsmps_point_fn add, void *acc);
+
+/* mf_lsmps_laplacian_add with each particle's extra points in its fit
+ * (extra NULL: the same as mf_lsmps_laplacian_add). */
+size_t mf_lsmps_laplacian_add_extra(const mf_pairs *v, const mf_kernel *k, const double *u,
+                                    double scale, const uint8_t *imask, const uint8_t *jmask,
+                                    mf_lsmps_extra_fn extra, const void *extra_ctx, double *out,
+                                    uint8_t *failed);
+
 #endif

@@ -73,6 +73,19 @@ static inline void mf_wall_viscous_add(const mf_wall_sums *s, const mf_kernel *k
         acc[a] += c * (visc_u[a] - s->visc * u_i[a]);
 }
 
+/* The no-slip velocity continued through the face at a virtual point s_v =
+ * depth behind it, for a particle d = dist from it (d at least d_min, as
+ * mf_wall_sums.visc): u_v = u_w - (s_v/d)(u_i - u_w) (Morris, Fox & Zhu
+ * 1997), i.e. 2 u_w - u_m with u_m the velocity at the point's mirror image
+ * interpolated linearly between the face and the particle; exact for a
+ * field linear in the distance to the face. Returns the factor phi of
+ * u_v - u_i = phi (u_w - u_i). */
+static inline double mf_wall_noslip_factor(double depth, double dist, double d_min)
+{
+    const double d = dist > d_min ? dist : d_min;
+    return 1.0 + depth / d;
+}
+
 /* The collision model against the face: a particle closer than `distance`
  * to the face (dist, normal into the fluid) that approaches it (relative to
  * the wall's velocity u_w) leaves with its normal velocity reversed times

@@ -8,6 +8,7 @@
 
 #include "mf_error.h"
 #include "mf_kernel.h"
+#include "mf_wall_lattice.h"
 
 /* Values stored per node, in the table's frame (constrained axes first). */
 enum { V_ZN = 0, V_G = 1, V_M = 4, V_T = 7, NV = 13 };
@@ -51,34 +52,24 @@ static void add_point(const mf_wall_tables *t, const double v[3], double *out)
     out[V_T + 5] += v[1] * v[2] * gi;
 }
 
+typedef struct sums_ctx {
+    const mf_wall_tables *t;
+    double *out;
+} sums_ctx;
+
+static void add_lattice_point(void *ctx, const double v[3])
+{
+    const sums_ctx *s = ctx;
+    add_point(s->t, v, s->out);
+}
+
 /* The sums of c constrained axes at offsets delta, the dim - c others free,
  * in the local frame, by brute force over the virtual lattice. */
 static void local_sums(const mf_wall_tables *t, int c, const double *delta, double *out)
 {
     memset(out, 0, NV * sizeof *out);
-    const double l0 = t->l0, R = t->re_max;
-    long lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
-    const long J = (long)floor(R / l0);
-    for (int a = 0; a < t->dim; a++) {
-        if (a < c) {
-            lo[a] = 0;
-            hi[a] = (long)ceil((R - delta[a]) / l0); /* delta + (i + 1/2) l0 < R */
-            if (hi[a] < 0)
-                return;
-        } else {
-            lo[a] = -J;
-            hi[a] = J;
-        }
-    }
-    double v[3] = {0, 0, 0};
-    for (long k = lo[2]; k <= hi[2]; k++)
-        for (long j = lo[1]; j <= hi[1]; j++)
-            for (long i = lo[0]; i <= hi[0]; i++) {
-                const long idx[3] = {i, j, k};
-                for (int a = 0; a < t->dim; a++)
-                    v[a] = a < c ? delta[a] + ((double)idx[a] + 0.5) * l0 : (double)idx[a] * l0;
-                add_point(t, v, out);
-            }
+    sums_ctx s = {t, out};
+    mf_wall_lattice_each(t->dim, t->l0, t->re_max, c, delta, add_lattice_point, &s);
 }
 
 static int build_table(mf_wall_tables *t, int c, double h)

@@ -227,4 +227,17 @@ bool mf_walls_sums(const mf_walls *ws, const mf_wall_tables *t, const double x[3
 bool mf_wall_sums_of(const mf_wall *w, const mf_wall_tables *t, int dim, double l0,
                      const double x[3], mf_wall_sums *s);
 
+/* The virtual points of one solid made of plane faces (tank, box) closer
+ * than R to x: each point of each term of its expansion (the lattice of
+ * mf_wall_lattice.h, in the body axes) as fn(ctx, r, depth, dist, sign),
+ * r the offset from x in the world frame, depth the point's distance
+ * behind the nearest of its term's planes (s_v), dist the particle's
+ * distance to that plane (d), sign the term's. For the least-squares
+ * Laplacian's wall points (mps_wall.c). Returns false for shapes without
+ * plane faces (cylinder, sphere, mesh), with no point given. */
+typedef void (*mf_wall_point_fn)(void *ctx, const double r[3], double depth, double dist,
+                                 double sign);
+bool mf_wall_points_each(const mf_wall *w, const mf_wall_tables *t, int dim, double l0,
+                         double R, const double x[3], mf_wall_point_fn fn, void *ctx);
+
 #endif

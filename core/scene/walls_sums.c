@@ -16,6 +16,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "mf_wall_lattice.h"
 #include "mf_walls.h"
 #include "walls_internal.h"
 
@@ -284,4 +285,74 @@ bool mf_walls_sums(const mf_walls *ws, const mf_wall_tables *t, const double x[3
         out->s.t[2] = out->s.t[4] = out->s.t[5] = 0;
     }
     return any;
+}
+
+/* mf_wall_points_each: a term's lattice point from its local frame (the
+ * constrained axes e[k], then the body axes the term leaves free) to the
+ * world frame. */
+typedef struct points_ctx {
+    const mf_wall_term *tm;
+    const double *R; /* body to world */
+    int dim, free_axis[3];
+    double R2; /* points at R or farther are left out */
+    mf_wall_point_fn fn;
+    void *ctx;
+} points_ctx;
+
+static void term_point(void *ctx, const double v[3])
+{
+    const points_ctx *pc = ctx;
+    const mf_wall_term *tm = pc->tm;
+    if (!(v[0] * v[0] + v[1] * v[1] + v[2] * v[2] < pc->R2))
+        return;
+    double b[3] = {0, 0, 0};
+    double depth = INFINITY, dist = 0;
+    for (int k = 0; k < tm->c; k++) {
+        for (int a = 0; a < 3; a++)
+            b[a] += v[k] * tm->e[k][a];
+        const double s = v[k] - tm->delta[k];
+        if (s < depth) {
+            depth = s;
+            dist = tm->delta[k];
+        }
+    }
+    for (int f = tm->c; f < pc->dim; f++)
+        b[pc->free_axis[f - tm->c]] += v[f];
+    if (tm->c == 0)
+        depth = dist = 0;
+    double r[3];
+    for (int a = 0; a < 3; a++)
+        r[a] = pc->R[3 * a] * b[0] + pc->R[3 * a + 1] * b[1] + pc->R[3 * a + 2] * b[2];
+    if (pc->dim == 2)
+        r[2] = 0;
+    pc->fn(pc->ctx, r, depth, dist, tm->sign);
+}
+
+bool mf_wall_points_each(const mf_wall *w, const mf_wall_tables *t, int dim, double l0,
+                         double R, const double x[3], mf_wall_point_fn fn, void *ctx)
+{
+    if (w->shape != MF_SOLID_TANK && w->shape != MF_SOLID_BOX)
+        return false;
+    double xb[3];
+    mf_wall_to_body(w, x, xb);
+    if (dim == 2)
+        xb[2] = 0;
+    mf_wall_term terms[MAX_TERMS];
+    const int nt = w->shape == MF_SOLID_TANK ? tank_terms(w, t, dim, xb, terms)
+                                             : box_terms(w, t, dim, xb, terms);
+    for (int k = 0; k < nt; k++) {
+        const mf_wall_term *tm = &terms[k];
+        points_ctx pc = {.tm = tm, .R = w->state.R, .dim = dim, .R2 = R * R, .fn = fn,
+                         .ctx = ctx};
+        int nfree = 0;
+        for (int a = 0; a < dim; a++) { /* the body axes no constrained axis takes */
+            bool used = false;
+            for (int c = 0; c < tm->c; c++)
+                used = used || fabs(tm->e[c][a]) > 0.5;
+            if (!used)
+                pc.free_axis[nfree++] = a;
+        }
+        mf_wall_lattice_each(dim, l0, R, tm->c, tm->delta, term_point, &pc);
+    }
+    return true;
 }

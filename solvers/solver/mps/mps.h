@@ -244,7 +244,8 @@ extern const char *const mps_scheme_choices[], *const mps_source_choices[],
      "leastSquares (LSMPS, Tamai & Koshizuka 2014)"},                                           \
     {"laplacian", MF_PARAM_WORD, "scheme", MF_NO_RANGE, mps_laplacian_choices, OFF(laplacian), \
      "Laplacian: paper (eq. 7), higherOrder (Khayyer & Gotoh 2010), leastSquares (LSMPS in "    \
-     "the viscous term, higherOrder in the pressure equation)"},                                \
+     "the viscous term, higherOrder in the pressure equation; with wall wallWeight the walls' " \
+     "virtual points enter each fit, tank and box solids only)"},                               \
     {"shifting", MF_PARAM_WORD, "scheme", MF_NO_RANGE, mps_shifting_choices, OFF(shifting),    \
      "particle shifting: none, fickian (Lind et al. 2012; tangential at the free surface)"},   \
     {"shiftCoefficient", MF_PARAM_SCALAR, "0.05", 0, 1, NULL, OFF(shift_coefficient),          \
@@ -447,6 +448,12 @@ void mps_wall_keep_forces(mps_data *d, const mf_sim *sim);
 void mps_wall_keep_approach(mps_data *d, const mf_sim *sim, double dt);
 void mps_wall_number_density(const mps_data *d, const mf_sim *sim, double *n);
 void mps_wall_viscous(mps_data *d, const mf_sim *sim, double nu);              /* into d->acc */
+/* eq. 7's wall term only where mask is set (the LSMPS fit's fallbacks). */
+void mps_wall_viscous_where(mps_data *d, const mf_sim *sim, double nu, const uint8_t *mask);
+/* laplacian leastSquares: nu <lap u> into d->acc by LSMPS with the walls'
+ * virtual points in each fit (plane faces); failed as mf_lsmps_laplacian_add. */
+size_t mps_wall_lsmps_laplacian(mps_data *d, const mf_sim *sim, const mf_pairs *v, double nu,
+                                uint8_t *failed);
 void mps_wall_divergence(const mps_data *d, const mf_sim *sim, const uint8_t *imask,
                          double *div);
 /* Into d->grad; phat: p^ of eq. 5 (the neighbourhood's minimum or p). */

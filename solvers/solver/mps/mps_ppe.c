@@ -306,7 +306,10 @@ int mps_assemble_ppe(mps_data *d, const mf_sim *sim, double dt)
      * the next step: its pages given back before the matrix is written. */
     if (rc == 0)
         (void)mps_scheme_release(d, false);
-    if (d->sc.laplacian != MPS_LAPLACIAN_PAPER) { /* higherOrder, and leastSquares' PPE */
+    /* higherOrder, and leastSquares' PPE; with wall wallWeight the walls add
+     * nothing to it, as to eq. 7's row (p_v = p_i: mps_wall.c), and LSMPS's
+     * wall points are the viscous term's only */
+    if (d->sc.laplacian != MPS_LAPLACIAN_PAPER) {
         c.hl = true;
         c.c = d->k_lap.hl_coef;
     }

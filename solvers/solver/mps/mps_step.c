@@ -99,11 +99,15 @@ static int viscous_term(mps_data *d, mf_sim *sim)
     MF_CALL(mps_scheme_reserve(d, p->n));
     uint8_t *failed = d->flag_work;
     memset(failed, 0, p->n);
-    size_t nfailed = mf_lsmps_laplacian_add(&v, &d->k_lap, p->vel, nu, d->is_fluid, d->not_dummy,
-                                            d->acc, failed);
+    /* wall wallWeight: the walls' virtual points in each fit (mps_wall.c) */
+    size_t nfailed = d->wall ? mps_wall_lsmps_laplacian(d, sim, &v, nu, failed)
+                             : mf_lsmps_laplacian_add(&v, &d->k_lap, p->vel, nu, d->is_fluid,
+                                                      d->not_dummy, d->acc, failed);
     if (nfailed) {
         d->ls_fallbacks += (long)nfailed;
         mf_laplacian_add(&v, &d->k_lap, p->vel, nu, failed, NULL, d->acc);
+        if (d->wall) /* and eq. 7's wall term there */
+            mps_wall_viscous_where(d, sim, nu, failed);
     }
     return 0;
 }
@@ -187,7 +191,8 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
         else
             mf_laplacian_add(&v, &d->k_lap, p->vel, nu, d->is_fluid, NULL, d->acc);
     }
-    if (d->wall && nu > 0) /* no slip on the walls' faces */
+    /* no slip on the walls' faces (leastSquares for one fluid: in its fit) */
+    if (d->wall && nu > 0 && (d->mu || d->sc.laplacian != MPS_LAPLACIAN_LEAST_SQUARES))
         mps_wall_viscous(d, sim, nu);
     MF_CALL(mps_bodies_viscous(d, sim)); /* the rigid bodies' share, at r^n */
     for (size_t i = 0; i < p->n_owned && !d->visc; i++) {
