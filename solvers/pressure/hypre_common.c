@@ -13,6 +13,7 @@
 #include <inttypes.h>
 #include <limits.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -575,6 +576,104 @@ int mf_hypre_setup_cycle(const char *who, HYPRE_Solver amg, const mf_csr *A,
     return 0;
 }
 
+/* Collective: hypre's PCG with pc on the assembled system (*solver: the
+ * caller destroys it); rep's iterations and set-up time, *t_solve when the
+ * iterations began. */
+static int hypre_pcg_run(const char *who, const mf_hypre_pcg *pcg, const mf_hypre_precond *pc,
+                         const hypre_system *sys, HYPRE_Solver *solver_out, mf_solve_report *rep,
+                         double t_start, double *t_solve)
+{
+    int rc = 0;
+    HYPRE_Solver solver = NULL;
+    MF_HYPRE_CALL(who, rc, done, HYPRE_ParCSRPCGCreate, (MPI_COMM_WORLD, &solver));
+    *solver_out = solver;
+    MF_HYPRE_CALL(who, rc, done, HYPRE_PCGSetTol, (solver, pcg->tolerance));
+    MF_HYPRE_CALL(who, rc, done, HYPRE_PCGSetMaxIter, (solver, (HYPRE_Int)pcg->max_iter));
+    /* Stop on ||r||_2 / ||b||_2, the residual we report, not the
+     * preconditioned norm. */
+    MF_HYPRE_CALL(who, rc, done, HYPRE_PCGSetTwoNorm, (solver, 1));
+    /* Before accepting convergence, recompute r = b - A x (one matvec): the
+     * recursively updated residual drifts from the true one, and we judge
+     * convergence by the true one below. */
+    MF_HYPRE_CALL(who, rc, done, HYPRE_PCGSetRecomputeResidual, (solver, 1));
+    MF_HYPRE_CALL(who, rc, done, HYPRE_PCGSetPrintLevel, (solver, 0));
+    MF_HYPRE_CALL(who, rc, done, HYPRE_PCGSetLogging, (solver, 0));
+    MF_HYPRE_CALL(who, rc, done, HYPRE_ParCSRPCGSetPrecond,
+                  (solver, pc->solve, pc->setup, pc->solver));
+    MF_HYPRE_CALL(who, rc, done, HYPRE_ParCSRPCGSetup, (solver, sys->parA, sys->parb, sys->parx));
+    *t_solve = MPI_Wtime();
+    rep->setup_seconds = *t_solve - t_start;
+
+    /* x holds the caller's initial guess: PCG starts from it. HYPRE_ERROR_CONV
+     * (iteration limit, or a breakdown) is not a library failure: the true
+     * residual decides (the caller's), and the caller may retry. */
+    HYPRE_Int ierr = HYPRE_ParCSRPCGSolve(solver, sys->parA, sys->parb, sys->parx);
+    if (ierr & ~HYPRE_ERROR_CONV) {
+        rc = mf_hypre_error(who, "HYPRE_ParCSRPCGSolve", ierr, __FILE__, __LINE__, __func__);
+        goto done;
+    }
+    HYPRE_ClearAllErrors();
+    HYPRE_Int iterations = 0;
+    MF_HYPRE_CALL(who, rc, done, HYPRE_ParCSRPCGGetNumIterations, (solver, &iterations));
+    rep->iterations = (int)iterations;
+done:
+    return rc;
+}
+
+/* ---- our V-cycle on several ranks ----------------------------------------- */
+
+/* The preconditioner's set-up as PCG calls it, once the hierarchy is set up. */
+static HYPRE_Int setup_done(HYPRE_Solver amg, HYPRE_ParCSRMatrix A, HYPRE_ParVector b,
+                            HYPRE_ParVector x)
+{
+    (void)amg;
+    (void)A;
+    (void)b;
+    (void)x;
+    return 0;
+}
+
+/* Collective: PCG with our V-cycle over pc's hierarchy (set up here when
+ * new) on the assembled system; *ran false when hypre's PCG is to run
+ * instead (the hierarchy set up, pc->setup then a no-op), the reason
+ * printed once by rank 0. */
+static int par_cycle_solve(const char *who, const mf_hypre_pcg *pcg, mf_hypre_precond *pc,
+                           const hypre_system *sys, double bnorm, mf_solve_report *rep,
+                           double t_start, double *t_solve, bool *ran)
+{
+    int rc = 0;
+    const char *why = NULL;
+    *ran = false;
+    if (pc->setup == HYPRE_BoomerAMGSetup) { /* a new hierarchy */
+        MF_HYPRE_CALL(who, rc, fail, HYPRE_BoomerAMGSetup,
+                      (pc->solver, sys->parA, sys->parb, sys->parx));
+        pc->setup = setup_done;
+        mf_amg_par_free(*pc->par);
+        *pc->par = NULL;
+        MF_CALL(mf_amg_par_take(pc->solver, pc->par, &why));
+    }
+    if (*pc->par) {
+        *t_solve = MPI_Wtime();
+        rep->setup_seconds = *t_solve - t_start;
+        rc = mf_amg_par_pcg(*pc->par, sys->parA, sys->parb, sys->parx, bnorm, pcg->tolerance,
+                            pcg->max_iter, &rep->iterations, &rep->final_residual, &why);
+        if (rc != 0 && rc != MF_RETRY)
+            return mf_error_trace(rc, __FILE__, __LINE__, __func__);
+        *ran = why == NULL;
+    }
+    int rank = 0;
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    if (why && pc->told && !*pc->told) {
+        if (rank == 0)
+            fprintf(stderr, "%s: hypre's PCG and V-cycle run instead of ours on several ranks: %s\n",
+                    who, why);
+        *pc->told = true;
+    }
+    return 0;
+fail:
+    return rc;
+}
+
 /* ---- pattern fingerprint (for reusing an AMG hierarchy) ------------------ */
 
 int mf_hypre_pattern_hash(const mf_csr *A, uint64_t *hash)
@@ -703,35 +802,16 @@ int mf_hypre_pcg_solve(const mf_hypre_pcg *pcg, const mf_csr *A, const double *b
     prepared = rc == 0;
     MF_CALL_GOTO(rc, mf_hypre_agree(who, rc), done);
 
-    MF_HYPRE_CALL(who, rc, done, HYPRE_ParCSRPCGCreate, (MPI_COMM_WORLD, &solver));
-    MF_HYPRE_CALL(who, rc, done, HYPRE_PCGSetTol, (solver, pcg->tolerance));
-    MF_HYPRE_CALL(who, rc, done, HYPRE_PCGSetMaxIter, (solver, (HYPRE_Int)pcg->max_iter));
-    /* Stop on ||r||_2 / ||b||_2, the residual we report, not the
-     * preconditioned norm. */
-    MF_HYPRE_CALL(who, rc, done, HYPRE_PCGSetTwoNorm, (solver, 1));
-    /* Before accepting convergence, recompute r = b - A x (one matvec): the
-     * recursively updated residual drifts from the true one, and we judge
-     * convergence by the true one below. */
-    MF_HYPRE_CALL(who, rc, done, HYPRE_PCGSetRecomputeResidual, (solver, 1));
-    MF_HYPRE_CALL(who, rc, done, HYPRE_PCGSetPrintLevel, (solver, 0));
-    MF_HYPRE_CALL(who, rc, done, HYPRE_PCGSetLogging, (solver, 0));
-    MF_HYPRE_CALL(who, rc, done, HYPRE_ParCSRPCGSetPrecond, (solver, pc.solve, pc.setup, pc.solver));
-    MF_HYPRE_CALL(who, rc, done, HYPRE_ParCSRPCGSetup, (solver, sys.parA, sys.parb, sys.parx));
-    const double t_solve = MPI_Wtime();
-    rep->setup_seconds = t_solve - t_start;
-
-    /* x holds the caller's initial guess: PCG starts from it. HYPRE_ERROR_CONV
-     * (iteration limit, or a breakdown) is not a library failure: the true
-     * residual below decides, and the caller may retry. */
-    HYPRE_Int ierr = HYPRE_ParCSRPCGSolve(solver, sys.parA, sys.parb, sys.parx);
-    if (ierr & ~HYPRE_ERROR_CONV) {
-        rc = mf_hypre_error(who, "HYPRE_ParCSRPCGSolve", ierr, __FILE__, __LINE__, __func__);
-        goto done;
+    double t_solve = MPI_Wtime();
+    bool ran = false; /* our PCG and V-cycle on several ranks */
+    if (lay.nprocs > 1 && pc.par != NULL) {
+        MF_CALL_GOTO(rc, par_cycle_solve(who, pcg, &pc, &sys, bnorm, rep, t_start, &t_solve,
+                                         &ran),
+                     done);
     }
-    HYPRE_ClearAllErrors();
-    HYPRE_Int iterations = 0;
-    MF_HYPRE_CALL(who, rc, done, HYPRE_ParCSRPCGGetNumIterations, (solver, &iterations));
-    rep->iterations = (int)iterations;
+    if (!ran)
+        MF_CALL_GOTO(rc, hypre_pcg_run(who, pcg, &pc, &sys, &solver, rep, t_start, &t_solve),
+                     done);
     MF_HYPRE_CALL(who, rc, done, HYPRE_IJVectorGetValues,
                   (sys.x, (HYPRE_Int)A->nrows, sys.rows, x));
 
