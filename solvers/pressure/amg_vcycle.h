@@ -1,5 +1,6 @@
 /* amg_vcycle.h: a V-cycle of our own over a hierarchy that hypre's BoomerAMG
- * set up, and the PCG around it, for a solve on one MPI rank.
+ * set up, and the PCG around it, for a solve on one MPI rank (amg_vcycle.c)
+ * and on several (amg_vcycle_par.c, declared at the end).
  *
  * Why: on one rank the solve phase of hypre's PCG + BoomerAMG spends its time
  * in loops that add one product at a time into one sum (the matrix-vector
@@ -155,6 +156,22 @@ void mf_amg_par_free(mf_amg_par *v);
 int mf_amg_par_pcg(mf_amg_par *v, HYPRE_ParCSRMatrix A, HYPRE_ParVector b, HYPRE_ParVector x,
                    double bnorm, double tol, long max_iter, int *iterations, double *rel,
                    const char **why);
+/* The rows' slots over the ranks (hypre_common.c's slot space): this rank's
+ * slot of each row, its slots [first, first + nslots) of hypre's rows, the
+ * slot of every global row (column), the first slot of each rank (nprocs +
+ * 1 entries). */
+typedef struct mf_par_slots {
+    const int64_t *slot;
+    int64_t nslots, first;
+    const int *of_row;
+    const int64_t *starts;
+} mf_par_slots;
+/* Collective: mf_amg_par_pcg for the caller's rows A in slot space, the
+ * fine level built from them without a hypre matrix (a kept hierarchy's
+ * solve); b, x in the rows' order. */
+int mf_amg_par_pcg_rows(mf_amg_par *v, const mf_csr *A, const mf_par_slots *ps, const double *b,
+                        double *x, double bnorm, double tol, long max_iter, int *iterations,
+                        double *rel, const char **why);
 /* Collective: z = M r, one cycle (for the tests), with A as in mf_amg_par_pcg. */
 int mf_amg_par_apply(mf_amg_par *v, HYPRE_ParCSRMatrix A, HYPRE_ParVector r, HYPRE_ParVector z);
 #endif

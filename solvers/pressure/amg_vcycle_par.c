@@ -55,10 +55,20 @@ typedef struct par_block {
     hypre_ParCSRCommPkg *pkg;
     int32_t nsend;               /* values sent (the package's send map) */
     double *send, *halo;         /* send buffer; the offd columns' values */
+    /* Built from the caller's rows (set_fine_rows): the offd block and the
+     * package are the block's own. */
+    int32_t *own_oi, *own_oj;
+    double *own_ov;
+    bool own_pkg;
 } par_block;
 
 static void block_free(par_block *b)
 {
+    if (b->own_pkg)
+        hypre_MatvecCommPkgDestroy(b->pkg);
+    free(b->own_oi);
+    free(b->own_oj);
+    free(b->own_ov);
     mf_split_csr_free(&b->D);
     free(b->send);
     free(b->halo);
@@ -439,6 +449,177 @@ static int set_fine(mf_amg_par *v, hypre_ParCSRMatrix *A, const char **why)
     return 0;
 }
 
+/* ---- the fine level from the caller's rows ------------------------------------ */
+
+static int cmp_int(const void *a, const void *b)
+{
+    const int x = *(const int *)a, y = *(const int *)b;
+    return (x > y) - (x < y);
+}
+
+/* This rank's rows of A in slot space as hypre_common.c's assembly makes
+ * them (a slot no row names: d x = 0, d the rows' mean |diagonal|), the
+ * columns this rank's slots (diag) or other ranks' (offd, in ascending
+ * global slot), and the comm package that moves the offd values: each rank
+ * asks the owners for the slots it reads (MPI_Alltoall of the counts,
+ * MPI_Alltoallv of the slots). */
+static int build_rows_block(par_block *F, const mf_csr *A, const mf_par_slots *ps)
+{
+    int nprocs = 1;
+    MPI_Comm_size(MPI_COMM_WORLD, &nprocs);
+    const int32_t n = (int32_t)ps->nslots, nrows = (int32_t)A->nrows;
+    const int first = (int)ps->first, total = (int)ps->starts[nprocs];
+    const size_t k0 = nrows > 0 ? A->rowptr[0] : 0;
+    const size_t nnz = nrows > 0 ? A->rowptr[nrows] - k0 : 0;
+    int rc = 0;
+    int32_t *row_of = malloc(((size_t)n + 1) * sizeof *row_of);
+    int *loc = malloc(((size_t)total + 1) * sizeof *loc);
+    int *cmap = malloc((nnz + 1) * sizeof *cmap);
+    size_t *rp = malloc(((size_t)n + 1) * sizeof *rp);
+    int32_t *dcol = malloc((nnz + (size_t)n + 1) * sizeof *dcol);
+    double *dval = malloc((nnz + (size_t)n + 1) * sizeof *dval);
+    F->own_oi = malloc(((size_t)n + 1) * sizeof *F->own_oi);
+    F->own_oj = malloc((nnz + 1) * sizeof *F->own_oj);
+    F->own_ov = malloc((nnz + 1) * sizeof *F->own_ov);
+    int *need = calloc((size_t)nprocs, sizeof *need), *give = calloc((size_t)nprocs, sizeof *give);
+    int *nd = calloc((size_t)nprocs, sizeof *nd), *gd = calloc((size_t)nprocs, sizeof *gd);
+    int *req = NULL;
+    if (!row_of || !loc || !cmap || !rp || !dcol || !dval || !F->own_oi || !F->own_oj ||
+        !F->own_ov || !need || !give || !nd || !gd)
+        rc = MF_ERROR(MF_ERR_MEMORY, "out of memory for the fine level (%d slots)", n);
+    MF_CALL_GOTO(rc, mf_hypre_agree("PCG_BoomerAMG", rc), out);
+
+    /* The other ranks' slots read, in ascending order (loc: their offd column). */
+    for (int32_t s = 0; s < n; s++)
+        row_of[s] = -1;
+    double dsum = 0.0;
+    int ncm = 0;
+    for (int32_t r = 0; r < nrows; r++) {
+        row_of[ps->slot[r]] = r;
+        for (size_t k = A->rowptr[r]; k < A->rowptr[r + 1]; k++) {
+            const int g = ps->of_row[A->col[k]];
+            if (g >= first && g < first + n) {
+                if (A->col[k] == A->row_offset + r)
+                    dsum += fabs(A->val[k]);
+            } else
+                cmap[ncm++] = g;
+        }
+    }
+    qsort(cmap, (size_t)ncm, sizeof *cmap, cmp_int);
+    int u = 0;
+    for (int j = 0; j < ncm; j++)
+        if (u == 0 || cmap[j] != cmap[u - 1])
+            cmap[u++] = cmap[j];
+    ncm = u;
+    for (int j = 0; j < ncm; j++)
+        loc[cmap[j]] = j;
+    const double dfree = nrows > 0 && dsum > 0 ? dsum / nrows : 1.0;
+
+    /* The rows by slot: diag block (local columns) and offd block. */
+    size_t kd = 0;
+    int32_t ko = 0;
+    for (int32_t s = 0; s < n; s++) {
+        rp[s] = kd;
+        F->own_oi[s] = ko;
+        const int32_t r = row_of[s];
+        if (r < 0) {
+            dcol[kd] = s;
+            dval[kd++] = dfree;
+            continue;
+        }
+        for (size_t k = A->rowptr[r]; k < A->rowptr[r + 1]; k++) {
+            const int g = ps->of_row[A->col[k]];
+            if (g >= first && g < first + n) {
+                dcol[kd] = g - first;
+                dval[kd++] = A->val[k];
+            } else {
+                F->own_oj[ko] = loc[g];
+                F->own_ov[ko++] = A->val[k];
+            }
+        }
+    }
+    rp[n] = kd;
+    F->own_oi[n] = ko;
+    const mf_csr D = {.nrows = (size_t)n, .nglobal = n, .rowptr = rp, .col = dcol, .val = dval};
+    MF_CALL_GOTO(rc, mf_split_csr_set(&F->D, &D), agree);
+    F->n = n;
+    F->ncols_offd = ncm;
+    F->oi = ko > 0 ? F->own_oi : NULL;
+    F->oj = F->own_oj;
+    F->ov = F->own_ov;
+
+    /* What this rank reads from each rank, and what each reads from it. */
+    for (int j = 0, p = 0; j < ncm; j++) {
+        while (cmap[j] >= ps->starts[p + 1])
+            p++;
+        need[p]++;
+    }
+    MPI_Alltoall(need, 1, MPI_INT, give, 1, MPI_INT, MPI_COMM_WORLD);
+    int ngive = 0, nrecv = 0, nsend = 0;
+    for (int p = 0; p < nprocs; p++) {
+        nd[p] = p > 0 ? nd[p - 1] + need[p - 1] : 0;
+        gd[p] = ngive;
+        ngive += give[p];
+        nrecv += need[p] > 0;
+        nsend += give[p] > 0;
+    }
+    req = malloc(((size_t)ngive + 1) * sizeof *req);
+    HYPRE_Int *recv_procs = hypre_CTAlloc(HYPRE_Int, nrecv + 1, HYPRE_MEMORY_HOST);
+    HYPRE_Int *recv_starts = hypre_CTAlloc(HYPRE_Int, nrecv + 1, HYPRE_MEMORY_HOST);
+    HYPRE_Int *send_procs = hypre_CTAlloc(HYPRE_Int, nsend + 1, HYPRE_MEMORY_HOST);
+    HYPRE_Int *send_starts = hypre_CTAlloc(HYPRE_Int, nsend + 1, HYPRE_MEMORY_HOST);
+    HYPRE_Int *send_elmts = hypre_CTAlloc(HYPRE_Int, ngive + 1, HYPRE_MEMORY_HOST);
+    if (!req || !recv_procs || !recv_starts || !send_procs || !send_starts || !send_elmts)
+        rc = MF_ERROR(MF_ERR_MEMORY, "out of memory for the fine level's halo (%d values)",
+                      ngive);
+    if (mf_hypre_agree("PCG_BoomerAMG", rc) == 0) {
+        MPI_Alltoallv(cmap, need, nd, MPI_INT, req, give, gd, MPI_INT, MPI_COMM_WORLD);
+        int q = 0;
+        for (int p = 0; p < nprocs; p++)
+            if (need[p] > 0) {
+                recv_procs[q] = p;
+                recv_starts[++q] = nd[p] + need[p];
+            }
+        q = 0;
+        for (int p = 0; p < nprocs; p++)
+            if (give[p] > 0) {
+                send_procs[q] = p;
+                send_starts[++q] = gd[p] + give[p];
+            }
+        for (int k = 0; k < ngive; k++)
+            send_elmts[k] = req[k] - first;
+        hypre_ParCSRCommPkgCreateAndFill(MPI_COMM_WORLD, nrecv, recv_procs, recv_starts, nsend,
+                                         send_procs, send_starts, send_elmts, &F->pkg);
+        F->own_pkg = true;
+        F->nsend = ngive;
+        F->send = malloc(((size_t)ngive + 1) * sizeof *F->send);
+        F->halo = calloc((size_t)ncm + 1, sizeof *F->halo);
+        if (!F->send || !F->halo)
+            rc = MF_ERROR(MF_ERR_MEMORY, "out of memory for a halo of %d values", ncm);
+    } else {
+        hypre_TFree(recv_procs, HYPRE_MEMORY_HOST);
+        hypre_TFree(recv_starts, HYPRE_MEMORY_HOST);
+        hypre_TFree(send_procs, HYPRE_MEMORY_HOST);
+        hypre_TFree(send_starts, HYPRE_MEMORY_HOST);
+        hypre_TFree(send_elmts, HYPRE_MEMORY_HOST);
+    }
+agree:
+    rc = mf_hypre_agree("PCG_BoomerAMG", rc);
+out:
+    free(row_of);
+    free(loc);
+    free(cmap);
+    free(rp);
+    free(dcol);
+    free(dval);
+    free(need);
+    free(give);
+    free(nd);
+    free(gd);
+    free(req);
+    return rc;
+}
+
 static double global_sum(double local)
 {
     double sum = 0.0;
@@ -551,6 +732,41 @@ static int pcg_run(mf_amg_par *v, const double *b, double *x, double bnorm, doub
     }
     *rel = residual(A, b, x, r) / bnorm;
     return MF_RETRY;
+}
+
+int mf_amg_par_pcg_rows(mf_amg_par *v, const mf_csr *A, const mf_par_slots *ps, const double *b,
+                        double *x, double bnorm, double tol, long max_iter, int *iterations,
+                        double *rel, const char **why)
+{
+    *iterations = 0;
+    *rel = NAN;
+    par_block *F = &v->lev[0].A;
+    block_free(F);
+    MF_CALL(build_rows_block(F, A, ps));
+    const bool fits = mf_hypre_all(F->n == v->lev[0].P.n);
+    *why = !fits ? "a system of other rows than the hierarchy's"
+           : !diag_positive(&F->D) ? "a diagonal entry of the matrix is not positive"
+                                   : NULL;
+    int rc = 0;
+    if (*why == NULL) {
+        const size_t n = (size_t)F->n;
+        double *bs = calloc(n + 1, sizeof *bs), *xs = calloc(n + 1, sizeof *xs);
+        rc = bs && xs ? 0 : MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu slots", n);
+        rc = mf_hypre_agree("PCG_BoomerAMG", rc);
+        if (rc == 0) {
+            for (size_t r = 0; r < A->nrows; r++) {
+                bs[ps->slot[r]] = b[r];
+                xs[ps->slot[r]] = x[r];
+            }
+            rc = pcg_run(v, bs, xs, bnorm, tol, max_iter, iterations, rel);
+            for (size_t r = 0; r < A->nrows; r++)
+                x[r] = xs[ps->slot[r]];
+        }
+        free(bs);
+        free(xs);
+    }
+    block_free(F);
+    return rc;
 }
 
 int mf_amg_par_pcg(mf_amg_par *v, HYPRE_ParCSRMatrix A, HYPRE_ParVector b, HYPRE_ParVector x,

@@ -35,13 +35,19 @@
  *    is one for all (may_keep): a rank whose particles changed (migration,
  *    reordering) makes every rank set a new hierarchy up, since hypre's
  *    set-up is collective and the hierarchy's row partition is the ranks'
- *    slot counts. The solve is then hypre's PCG (our V-cycle runs on one
- *    rank only).
+ *    slot counts.
  *  - reuseSetup > 0 keeps the hierarchy for that many further solves as
  *    long as the matrix size and sparsity pattern do not change (the
  *    implicit viscosity: one matrix, a solve per velocity component).
  * A kept hierarchy that fails to converge is rebuilt and the solve repeated
  * once from the same initial guess.
+ *
+ * ownCycle (default yes) with relaxType 3: hypre sets the hierarchy up, our
+ * PCG and V-cycle run it (amg_vcycle.h): on one rank a copy of it, on
+ * several hypre's levels read in place with their comm packages
+ * (amg_vcycle_par.c; hypre's solver is kept, its own PCG and cycle the
+ * fallback when ours cannot run, the reason printed once). no: hypre's PCG
+ * and V-cycle.
  */
 #define MF_PRESSURE_HYPRE_INTERNAL
 #include "pressure_hypre.h"
