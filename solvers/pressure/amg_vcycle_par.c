@@ -489,9 +489,12 @@ static int build_rows_block(par_block *F, const mf_csr *A, const mf_par_slots *p
         rc = MF_ERROR(MF_ERR_MEMORY, "out of memory for the fine level (%d slots)", n);
     MF_CALL_GOTO(rc, mf_hypre_agree("PCG_BoomerAMG", rc), out);
 
-    /* The other ranks' slots read, in ascending order (loc: their offd column). */
+    /* The other ranks' slots read, once each (loc marks them), then in
+     * ascending order (loc: their offd column). */
     for (int32_t s = 0; s < n; s++)
         row_of[s] = -1;
+    for (int g = 0; g < total; g++)
+        loc[g] = -1;
     double dsum = 0.0;
     int ncm = 0;
     for (int32_t r = 0; r < nrows; r++) {
@@ -501,16 +504,13 @@ static int build_rows_block(par_block *F, const mf_csr *A, const mf_par_slots *p
             if (g >= first && g < first + n) {
                 if (A->col[k] == A->row_offset + r)
                     dsum += fabs(A->val[k]);
-            } else
+            } else if (loc[g] < 0) {
+                loc[g] = 0;
                 cmap[ncm++] = g;
+            }
         }
     }
     qsort(cmap, (size_t)ncm, sizeof *cmap, cmp_int);
-    int u = 0;
-    for (int j = 0; j < ncm; j++)
-        if (u == 0 || cmap[j] != cmap[u - 1])
-            cmap[u++] = cmap[j];
-    ncm = u;
     for (int j = 0; j < ncm; j++)
         loc[cmap[j]] = j;
     const double dfree = nrows > 0 && dsum > 0 ? dsum / nrows : 1.0;
