@@ -75,6 +75,15 @@ static void block_free(par_block *b)
     memset(b, 0, sizeof *b);
 }
 
+/* Whether a block holds entries (by its row pointers, not the count
+ * field). */
+static bool has_entries(hypre_CSRMatrix *M)
+{
+    const HYPRE_Int *I = hypre_CSRMatrixI(M);
+    const HYPRE_Int n = hypre_CSRMatrixNumRows(M);
+    return I != NULL && n > 0 && I[n] > I[0];
+}
+
 /* b over this rank's rows of M; split: the diag block copied for the
  * sweeps (a level's matrix), else read in place (an interpolation). */
 static int block_set(par_block *b, hypre_ParCSRMatrix *M, bool split)
@@ -82,7 +91,7 @@ static int block_set(par_block *b, hypre_ParCSRMatrix *M, bool split)
     hypre_CSRMatrix *D = hypre_ParCSRMatrixDiag(M), *O = hypre_ParCSRMatrixOffd(M);
     b->n = hypre_CSRMatrixNumRows(D);
     b->ncols_offd = hypre_CSRMatrixNumCols(O);
-    if (hypre_CSRMatrixNumNonzeros(O) > 0 && hypre_CSRMatrixI(O) != NULL) {
+    if (has_entries(O)) {
         b->oi = hypre_CSRMatrixI(O);
         b->oj = hypre_CSRMatrixJ(O);
         b->ov = hypre_CSRMatrixData(O);
@@ -207,7 +216,7 @@ static int gather_coarsest(mf_amg_par *v, hypre_ParCSRMatrix *C, int nprocs)
     const int n = hypre_CSRMatrixNumRows(D);
     const HYPRE_Int *I = hypre_CSRMatrixI(D), *J = hypre_CSRMatrixJ(D);
     const HYPRE_Real *V = hypre_CSRMatrixData(D);
-    const bool has_offd = hypre_CSRMatrixNumNonzeros(O) > 0 && hypre_CSRMatrixI(O) != NULL;
+    const bool has_offd = has_entries(O);
     const HYPRE_Int *OI = hypre_CSRMatrixI(O), *OJ = hypre_CSRMatrixJ(O);
     const HYPRE_Real *OV = hypre_CSRMatrixData(O);
     const HYPRE_BigInt *cmap = hypre_ParCSRMatrixColMapOffd(C);
@@ -308,7 +317,11 @@ int mf_amg_par_take(HYPRE_Solver amg, mf_amg_par **out, const char **why)
         v = NULL;
     }
     rc = v ? 0 : MF_ERROR(MF_ERR_MEMORY, "out of memory for an AMG hierarchy");
-    MF_CALL(mf_hypre_agree("PCG_BoomerAMG", rc));
+    rc = mf_hypre_agree("PCG_BoomerAMG", rc);
+    if (rc != 0) {
+        mf_amg_par_free(v);
+        return mf_error_trace(rc, __FILE__, __LINE__, __func__);
+    }
     v->nlevels = nlevels;
     v->nc = (int)nc;
     for (int l = 0; l < nlevels && rc == 0; l++) {
