@@ -300,7 +300,10 @@ int mf_amg_par_take(HYPRE_Solver amg, mf_amg_par **out, const char **why)
         return 0;
     }
     if (!mf_amg_cycle_is_ours(amg)) {
-        *why = "the settings make another cycle than relaxType 3 down, 4 up";
+        const HYPRE_Int *type = hypre_ParAMGDataGridRelaxType(d);
+        *why = type && type[1] == 3 && type[2] == 4 && type[3] != 9
+                   ? "hypre relaxes the coarsest level instead of Gaussian elimination"
+                   : "the settings make another cycle than relaxType 3 down, 4 up";
         return 0;
     }
     hypre_ParCSRMatrix **A = hypre_ParAMGDataAArray(d), **P = hypre_ParAMGDataPArray(d);

@@ -638,6 +638,20 @@ static HYPRE_Int setup_done(HYPRE_Solver amg, HYPRE_ParCSRMatrix A, HYPRE_ParVec
     return 0;
 }
 
+/* Why hypre's PCG runs instead of ours (why NULL: it does not), printed by
+ * rank 0, once a module (pc->told). */
+static void tell_fallback(const char *who, const mf_hypre_precond *pc, const char *why)
+{
+    if (why == NULL || pc->told == NULL || *pc->told)
+        return;
+    int rank = 0;
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    if (rank == 0)
+        fprintf(stderr, "%s: hypre's PCG and V-cycle run instead of ours on several ranks: %s\n",
+                who, why);
+    *pc->told = true;
+}
+
 /* Collective: PCG with our V-cycle over pc's hierarchy (set up here when
  * new) on the assembled system; *ran false when hypre's PCG is to run
  * instead (the hierarchy set up, pc->setup then a no-op), the reason
@@ -666,14 +680,7 @@ static int par_cycle_solve(const char *who, const mf_hypre_pcg *pcg, mf_hypre_pr
             return mf_error_trace(rc, __FILE__, __LINE__, __func__);
         *ran = why == NULL;
     }
-    int rank = 0;
-    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-    if (why && pc->told && !*pc->told) {
-        if (rank == 0)
-            fprintf(stderr, "%s: hypre's PCG and V-cycle run instead of ours on several ranks: %s\n",
-                    who, why);
-        *pc->told = true;
-    }
+    tell_fallback(who, pc, why);
     return 0;
 fail:
     return rc;
@@ -698,14 +705,7 @@ static int par_rows_solve(const char *who, const mf_hypre_pcg *pcg, mf_hypre_pre
     if (rc != 0 && rc != MF_RETRY)
         return mf_error_trace(rc, __FILE__, __LINE__, __func__);
     *ran = why == NULL;
-    int rank = 0;
-    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-    if (why && pc->told && !*pc->told) {
-        if (rank == 0)
-            fprintf(stderr, "%s: hypre's PCG and V-cycle run instead of ours on several ranks: %s\n",
-                    who, why);
-        *pc->told = true;
-    }
+    tell_fallback(who, pc, why);
     return 0;
 }
 
