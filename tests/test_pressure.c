@@ -829,7 +829,8 @@ static void test_own_vcycle_ranks(void)
     HYPRE_BigInt *wrows = malloc((N + 1) * sizeof *wrows);
     HYPRE_BigInt *wcols = malloc((w.A.rowptr[N] + 1) * sizeof *wcols);
     double *wbv = malloc((N + 1) * sizeof *wbv), *wxv = calloc(N + 1, sizeof *wxv);
-    int *counts = malloc((size_t)nprocs * sizeof *counts), *displs = malloc((size_t)nprocs * sizeof *displs);
+    int *counts = malloc((size_t)nprocs * sizeof *counts);
+    int *displs = malloc((size_t)nprocs * sizeof *displs);
     for (int q = 0; q < nprocs; q++) {
         displs[q] = (int)((int64_t)N * q / nprocs);
         counts[q] = (int)((int64_t)N * (q + 1) / nprocs) - displs[q];

@@ -229,7 +229,8 @@ static int gather_coarsest(mf_amg_par *v, hypre_ParCSRMatrix *C, int nprocs)
     v->c_n = n;
     v->counts = malloc((size_t)nprocs * sizeof *v->counts);
     v->displs = malloc((size_t)nprocs * sizeof *v->displs);
-    int *nnzs = malloc((size_t)nprocs * sizeof *nnzs), *ndispl = malloc((size_t)nprocs * sizeof *ndispl);
+    int *nnzs = malloc((size_t)nprocs * sizeof *nnzs);
+    int *ndispl = malloc((size_t)nprocs * sizeof *ndispl);
     int *rc3 = malloc(((size_t)nnz + 1) * 2 * sizeof *rc3);
     double *vals = malloc(((size_t)nnz + 1) * sizeof *vals);
     v->fc = malloc(((size_t)nc + 1) * sizeof *v->fc);
@@ -335,7 +336,8 @@ int mf_amg_par_take(HYPRE_Solver amg, mf_amg_par **out, const char **why)
             rc = block_set(&L->A, A[l], true);
         /* (level 0 uses its residual only) */
         if (rc == 0)
-            rc = alloc_vectors(L, hypre_CSRMatrixNumRows(hypre_ParCSRMatrixDiag(l > 0 ? A[l] : P[0])));
+            rc = alloc_vectors(L,
+                               hypre_CSRMatrixNumRows(hypre_ParCSRMatrixDiag(l > 0 ? A[l] : P[0])));
     }
     MF_CALL_GOTO(rc, mf_hypre_agree("PCG_BoomerAMG", rc), fail);
     bool positive = true;

@@ -338,7 +338,8 @@ static int cycle_prepare(void *ctx, const mf_csr *A, const mf_row_names *rows,
     pcg_boomeramg *d = ctx;
     *cycle = NULL;
     d->reused = false;
-    if (d->s.relax_type != 3 || !d->s.own_cycle || d->amg != NULL) /* hypre's own, or a hierarchy of hypre's kept */
+    /* hypre's own cycle asked for, or a hierarchy of hypre's kept */
+    if (d->s.relax_type != 3 || !d->s.own_cycle || d->amg != NULL)
         return 0;
     if (rows && d->s.reuse_hierarchy) {
         if (d->cycle && may_keep(d, rows)) {
