@@ -15,7 +15,11 @@
 # serial work / the largest rank's work. Start-up is included (every rank
 # reads the case and builds the whole scene).
 #
-# Environment: MPSFLOW (default build/driver/mpsflow), L0, ENDTIME, MPIRUN.
+# Environment: MPSFLOW (default build/driver/mpsflow), L0, ENDTIME, MPIRUN;
+# MULTI (default "no yes": the multiCriteria of the 2-rank runs); PRESSURE,
+# keys added to solverDict's pressure dictionary (e.g. "ownCycle no;": hypre's
+# PCG and V-cycle instead of ours); SERIAL (default yes; no: the 2-rank runs
+# only).
 cd "$(dirname "$0")/.." || exit 1
 ROOT=$PWD
 MPSFLOW=${MPSFLOW:-$ROOT/build/driver/mpsflow}
@@ -24,6 +28,9 @@ WORK=${1:-${TMPDIR:-/tmp}/mpsflow-mpi-work}
 L0=${L0:-0.02}
 ENDTIME=${ENDTIME:-0.004}
 MPIRUN=${MPIRUN:-mpirun --oversubscribe --allow-run-as-root}
+MULTI=${MULTI:-no yes}
+PRESSURE=${PRESSURE:-}
+SERIAL=${SERIAL:-yes}
 export OMP_NUM_THREADS=1 OMP_WAIT_POLICY=passive
 mkdir -p "$WORK"
 
@@ -33,6 +40,8 @@ prepare() {
     mkdir -p "$1"
     cp -r tutorials/damBreak3D/system tutorials/damBreak3D/constant "$1/"
     printf 'multiCriteria %s;\n' "$2" > "$1/system/decomposeParDict"
+    [ -z "$PRESSURE" ] ||
+        sed -i "s|^\( *solver *PCG_BoomerAMG;\)|\1 $PRESSURE|" "$1/system/solverDict"
 }
 
 # split FILE: instructions by object, millions.
@@ -59,12 +68,14 @@ split() {
         }'
 }
 
-d=$WORK/serial
-prepare "$d" yes
-valgrind --tool=callgrind --callgrind-out-file="$d/cg.out" "$MPSFLOW" -case "$d" -l0 "$L0" \
-    -endTime "$ENDTIME" > "$d/log" 2>&1 || { echo "serial run failed: $d/log"; exit 1; }
-echo "serial: $(split "$d/cg.out")"
-for multi in no yes; do
+if [ "$SERIAL" = yes ]; then
+    d=$WORK/serial
+    prepare "$d" yes
+    valgrind --tool=callgrind --callgrind-out-file="$d/cg.out" "$MPSFLOW" -case "$d" -l0 "$L0" \
+        -endTime "$ENDTIME" > "$d/log" 2>&1 || { echo "serial run failed: $d/log"; exit 1; }
+    echo "serial: $(split "$d/cg.out")"
+fi
+for multi in $MULTI; do
     d=$WORK/np2.$multi
     prepare "$d" $multi
     $MPIRUN -np 2 valgrind --tool=callgrind --callgrind-out-file="$d/cg.%q{OMPI_COMM_WORLD_RANK}" \

@@ -34,10 +34,10 @@ typedef struct poisson {
 } poisson;
 
 /* This rank's block of rows of the n*n grid (row = i + n j), in CSR. */
-static void poisson_build(poisson *p, int n)
+static void poisson_build_part(poisson *p, int n, int part, int nparts)
 {
     const int64_t N = (int64_t)n * n;
-    const int64_t lo = N * rank / nprocs, hi = N * (rank + 1) / nprocs;
+    const int64_t lo = N * part / nparts, hi = N * (part + 1) / nparts;
     const size_t nrows = (size_t)(hi - lo);
     memset(p, 0, sizeof *p);
     p->A.nrows = nrows;
@@ -74,6 +74,34 @@ static void poisson_build(poisson *p, int n)
         p->x_exact[r] = sin(3.0 * sx) * cos(2.0 * sy) + 0.3 * noise;
     }
     p->A.rowptr[nrows] = k;
+}
+
+static void poisson_build(poisson *p, int n)
+{
+    poisson_build_part(p, n, rank, nprocs);
+}
+
+/* Variable coefficients: a symmetric matrix less regular than the 5-point
+ * stencil, its diagonal the off-diagonal sums plus a little (by global
+ * rows and columns: the same matrix on any number of ranks). */
+static void vary_coefficients(poisson *p)
+{
+    const size_t n = p->A.nrows;
+    for (size_t r = 0; r < n; r++) {
+        const int64_t g = p->A.row_offset + (int64_t)r;
+        double dsum = 0.0;
+        size_t kd = 0;
+        for (size_t k = p->A.rowptr[r]; k < p->A.rowptr[r + 1]; k++) {
+            const int64_t c = p->A.col[k];
+            if (c != g) {
+                const int64_t lo = g < c ? g : c, hi = g < c ? c : g;
+                p->A.val[k] = -(1.0 + 0.5 * sin(0.37 * (double)lo + 0.11 * (double)hi));
+                dsum -= p->A.val[k];
+            } else
+                kd = k;
+        }
+        p->A.val[kd] = dsum + 0.01;
+    }
 }
 
 static void poisson_free(poisson *p)
@@ -574,23 +602,8 @@ static void test_own_vcycle(void)
     omp_set_num_threads(1);
     poisson p;
     poisson_build(&p, 48);
-    /* Variable coefficients: a symmetric matrix less regular than the
-     * 5-point stencil, its diagonal the off-diagonal sums plus a little. */
+    vary_coefficients(&p);
     const size_t n = p.A.nrows;
-    double *dsum = calloc(n, sizeof *dsum);
-    for (size_t r = 0; r < n; r++)
-        for (size_t k = p.A.rowptr[r]; k < p.A.rowptr[r + 1]; k++) {
-            const size_t c = (size_t)p.A.col[k];
-            if (c != r) {
-                const size_t lo = r < c ? r : c, hi = r < c ? c : r;
-                p.A.val[k] = -(1.0 + 0.5 * sin(0.37 * (double)lo + 0.11 * (double)hi));
-                dsum[r] -= p.A.val[k];
-            }
-        }
-    for (size_t r = 0; r < n; r++)
-        for (size_t k = p.A.rowptr[r]; k < p.A.rowptr[r + 1]; k++)
-            if ((size_t)p.A.col[k] == r)
-                p.A.val[k] = dsum[r] + 0.01;
 
     /* hypre's matrix and vectors. */
     HYPRE_IJMatrix ij = NULL;
@@ -697,7 +710,209 @@ static void test_own_vcycle(void)
     free(r);
     free(zh);
     free(zo);
-    free(dsum);
+    poisson_free(&p);
+    omp_set_num_threads(saved_threads);
+}
+
+/* On several ranks: our V-cycle over hypre's hierarchy across the ranks is
+ * hypre's cycle (relaxType 3 down, 4 up: Gauss-Seidel within a rank's rows,
+ * Jacobi across), our PCG takes hypre's iterations within 2, and the
+ * solution is the serial one within the tolerance. */
+static void test_own_vcycle_ranks(void)
+{
+    if (nprocs == 1)
+        return;
+    const int saved_threads = omp_get_max_threads();
+    omp_set_num_threads(1);
+    enum { NGRID = 48 };
+    poisson p;
+    poisson_build(&p, NGRID);
+    vary_coefficients(&p);
+    const size_t n = p.A.nrows;
+    const HYPRE_BigInt lo = (HYPRE_BigInt)p.A.row_offset, up = lo + (HYPRE_BigInt)n - 1;
+
+    HYPRE_IJMatrix ij = NULL;
+    HYPRE_IJVector ijr = NULL, ijz = NULL, ijo = NULL;
+    HYPRE_ParVector parr = NULL, parz = NULL, paro = NULL;
+    void *obj = NULL;
+    HYPRE_Int *ncols = malloc((n + 1) * sizeof *ncols);
+    HYPRE_BigInt *rows = malloc((n + 1) * sizeof *rows);
+    HYPRE_BigInt *cols = malloc((p.A.rowptr[n] + 1) * sizeof *cols);
+    double *r = malloc((n + 1) * sizeof *r), *zh = calloc(n + 1, sizeof *zh);
+    double *zo = calloc(n + 1, sizeof *zo);
+    for (size_t i = 0; i < n; i++) {
+        rows[i] = lo + (HYPRE_BigInt)i;
+        ncols[i] = (HYPRE_Int)(p.A.rowptr[i + 1] - p.A.rowptr[i]);
+        r[i] = cos(0.3 * (double)rows[i]) + 0.2 * (double)(rows[i] % 7);
+    }
+    for (size_t k = 0; k < p.A.rowptr[n]; k++)
+        cols[k] = (HYPRE_BigInt)p.A.col[k];
+    CHECK(HYPRE_IJMatrixCreate(MPI_COMM_WORLD, lo, up, lo, up, &ij) == 0);
+    HYPRE_IJMatrixSetObjectType(ij, HYPRE_PARCSR);
+    HYPRE_IJMatrixInitialize(ij);
+    HYPRE_IJMatrixSetValues(ij, (HYPRE_Int)n, ncols, rows, cols, p.A.val);
+    CHECK(HYPRE_IJMatrixAssemble(ij) == 0);
+    HYPRE_IJMatrixGetObject(ij, &obj);
+    HYPRE_ParCSRMatrix parA = obj;
+    HYPRE_IJVector *vecs[3] = {&ijr, &ijz, &ijo};
+    HYPRE_ParVector *pars[3] = {&parr, &parz, &paro};
+    for (int v = 0; v < 3; v++) {
+        HYPRE_IJVectorCreate(MPI_COMM_WORLD, lo, up, vecs[v]);
+        HYPRE_IJVectorSetObjectType(*vecs[v], HYPRE_PARCSR);
+        HYPRE_IJVectorInitialize(*vecs[v]);
+        HYPRE_IJVectorSetValues(*vecs[v], (HYPRE_Int)n, rows, v == 0 ? r : zh);
+        HYPRE_IJVectorAssemble(*vecs[v]);
+        HYPRE_IJVectorGetObject(*vecs[v], &obj);
+        *pars[v] = obj;
+    }
+
+    /* One cycle: hypre's z = M r from z = 0, and ours. */
+    mf_pcg_boomeramg_settings s;
+    defaults(&mf_pressure_PCG_BoomerAMG, &s);
+    HYPRE_Solver amg = NULL;
+    CHECK_OK(mf_boomeramg_create(&s, &amg));
+    CHECK(HYPRE_BoomerAMGSetup(amg, parA, parr, parz) == 0);
+    CHECK(HYPRE_BoomerAMGSolve(amg, parA, parr, parz) == 0);
+    HYPRE_IJVectorGetValues(ijz, (HYPRE_Int)n, rows, zh);
+    mf_amg_par *cycle = NULL;
+    const char *why = NULL;
+    CHECK_OK(mf_amg_par_take(amg, &cycle, &why));
+    CHECK_MSG(cycle != NULL, "the default settings' hierarchy is not one our cycle runs: %s",
+              why ? why : "?");
+    if (cycle != NULL) {
+        CHECK_OK(mf_amg_par_apply(cycle, parA, parr, paro));
+        HYPRE_IJVectorGetValues(ijo, (HYPRE_Int)n, rows, zo);
+        double dmax = 0.0, zmax = 0.0;
+        for (size_t i = 0; i < n; i++) {
+            dmax = fmax(dmax, fabs(zo[i] - zh[i]));
+            zmax = fmax(zmax, fabs(zh[i]));
+        }
+        double m[2] = {dmax, zmax}, g[2];
+        MPI_Allreduce(m, g, 2, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+        if (rank == 0)
+            printf("own V-cycle against hypre's on %d ranks: max |difference| %.3g of max |z| "
+                   "%.3g\n", nprocs, g[0], g[1]);
+        CHECK_MSG(g[1] > 0.0 && g[0] <= 1e-12 * g[1], "V-cycles differ by %g (max |z| %g)", g[0],
+                  g[1]);
+    }
+    mf_amg_par_free(cycle);
+    HYPRE_BoomerAMGDestroy(amg);
+
+    /* PCG: the module's (ours) against the module's with ownCycle no
+     * (hypre's PCG and cycle), the same settings and tolerance. */
+    make_rhs(&p);
+    mf_solve_report own, hyp;
+    memset(p.x, 0, n * sizeof *p.x);
+    CHECK_OK(solve_once(&mf_pressure_PCG_BoomerAMG, &s, &p, &own));
+    double *x_own = malloc((n + 1) * sizeof *x_own);
+    memcpy(x_own, p.x, n * sizeof *x_own);
+    const double err_own = rel_error(&p);
+    mf_pcg_boomeramg_settings sh = s;
+    sh.own_cycle = false;
+    memset(p.x, 0, n * sizeof *p.x);
+    CHECK_OK(solve_once(&mf_pressure_PCG_BoomerAMG, &sh, &p, &hyp));
+    CHECK(own.converged && own.final_residual <= s.tolerance);
+    CHECK(hyp.converged && hyp.final_residual <= s.tolerance);
+    CHECK_MSG(abs(own.iterations - hyp.iterations) <= 2, "%d iterations against hypre's %d",
+              own.iterations, hyp.iterations);
+    CHECK(err_own <= kappa_poisson(NGRID) * 100 * own.final_residual);
+
+    /* The serial solution: the whole matrix on each rank alone (hypre's PCG
+     * and cycle on one rank: ours there is the same, test_own_vcycle). */
+    poisson w;
+    poisson_build_part(&w, NGRID, 0, 1);
+    vary_coefficients(&w);
+    const size_t N = w.A.nrows;
+    HYPRE_IJMatrix wij = NULL;
+    HYPRE_IJVector wb = NULL, wx = NULL;
+    HYPRE_Int *wn = malloc((N + 1) * sizeof *wn);
+    HYPRE_BigInt *wrows = malloc((N + 1) * sizeof *wrows);
+    HYPRE_BigInt *wcols = malloc((w.A.rowptr[N] + 1) * sizeof *wcols);
+    double *wbv = malloc((N + 1) * sizeof *wbv), *wxv = calloc(N + 1, sizeof *wxv);
+    int *counts = malloc((size_t)nprocs * sizeof *counts);
+    int *displs = malloc((size_t)nprocs * sizeof *displs);
+    for (int q = 0; q < nprocs; q++) {
+        displs[q] = (int)((int64_t)N * q / nprocs);
+        counts[q] = (int)((int64_t)N * (q + 1) / nprocs) - displs[q];
+    }
+    MPI_Allgatherv(p.b, (int)n, MPI_DOUBLE, wbv, counts, displs, MPI_DOUBLE, MPI_COMM_WORLD);
+    for (size_t i = 0; i < N; i++) {
+        wrows[i] = (HYPRE_BigInt)i;
+        wn[i] = (HYPRE_Int)(w.A.rowptr[i + 1] - w.A.rowptr[i]);
+    }
+    for (size_t k = 0; k < w.A.rowptr[N]; k++)
+        wcols[k] = (HYPRE_BigInt)w.A.col[k];
+    const HYPRE_BigInt wup = (HYPRE_BigInt)N - 1;
+    HYPRE_IJMatrixCreate(MPI_COMM_SELF, 0, wup, 0, wup, &wij);
+    HYPRE_IJMatrixSetObjectType(wij, HYPRE_PARCSR);
+    HYPRE_IJMatrixInitialize(wij);
+    HYPRE_IJMatrixSetValues(wij, (HYPRE_Int)N, wn, wrows, wcols, w.A.val);
+    CHECK(HYPRE_IJMatrixAssemble(wij) == 0);
+    HYPRE_IJMatrixGetObject(wij, &obj);
+    HYPRE_ParCSRMatrix wA = obj;
+    HYPRE_ParVector wpb = NULL, wpx = NULL;
+    HYPRE_IJVector *wv[2] = {&wb, &wx};
+    HYPRE_ParVector *wp[2] = {&wpb, &wpx};
+    for (int v = 0; v < 2; v++) {
+        HYPRE_IJVectorCreate(MPI_COMM_SELF, 0, wup, wv[v]);
+        HYPRE_IJVectorSetObjectType(*wv[v], HYPRE_PARCSR);
+        HYPRE_IJVectorInitialize(*wv[v]);
+        HYPRE_IJVectorSetValues(*wv[v], (HYPRE_Int)N, wrows, v == 0 ? wbv : wxv);
+        HYPRE_IJVectorAssemble(*wv[v]);
+        HYPRE_IJVectorGetObject(*wv[v], &obj);
+        *wp[v] = obj;
+    }
+    HYPRE_Solver pcg = NULL;
+    CHECK_OK(mf_boomeramg_create(&s, &amg));
+    HYPRE_ParCSRPCGCreate(MPI_COMM_SELF, &pcg);
+    HYPRE_PCGSetTol(pcg, s.tolerance);
+    HYPRE_PCGSetMaxIter(pcg, 500);
+    HYPRE_PCGSetTwoNorm(pcg, 1);
+    HYPRE_PCGSetRecomputeResidual(pcg, 1);
+    HYPRE_ParCSRPCGSetPrecond(pcg, HYPRE_BoomerAMGSolve, HYPRE_BoomerAMGSetup, amg);
+    HYPRE_ParCSRPCGSetup(pcg, wA, wpb, wpx);
+    CHECK(HYPRE_ParCSRPCGSolve(pcg, wA, wpb, wpx) == 0);
+    HYPRE_Int its = 0;
+    HYPRE_ParCSRPCGGetNumIterations(pcg, &its);
+    HYPRE_IJVectorGetValues(wx, (HYPRE_Int)N, wrows, wxv);
+    double d2 = 0.0, x2 = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        const double xs = wxv[(size_t)p.A.row_offset + i];
+        d2 += (x_own[i] - xs) * (x_own[i] - xs);
+        x2 += xs * xs;
+    }
+    const double diff = sqrt(global_sum(d2) / global_sum(x2));
+    /* Both residuals at most tol: each error at most kappa tol. */
+    const double bound = 2.0 * kappa_poisson(NGRID) * s.tolerance;
+    if (rank == 0)
+        printf("PCG on %d ranks: %d iterations with our V-cycle, %d with hypre's, %d serially; "
+               "|x - x_serial| / |x_serial| %.3g (bound %.3g)\n",
+               nprocs, own.iterations, hyp.iterations, (int)its, diff, bound);
+    CHECK_MSG(diff <= bound, "the solution on %d ranks is %g from the serial one", nprocs, diff);
+    HYPRE_ParCSRPCGDestroy(pcg);
+    HYPRE_BoomerAMGDestroy(amg);
+    HYPRE_IJMatrixDestroy(wij);
+    HYPRE_IJVectorDestroy(wb);
+    HYPRE_IJVectorDestroy(wx);
+    free(wn);
+    free(wrows);
+    free(wcols);
+    free(wbv);
+    free(wxv);
+    free(counts);
+    free(displs);
+    poisson_free(&w);
+
+    HYPRE_IJMatrixDestroy(ij);
+    for (int v = 0; v < 3; v++)
+        HYPRE_IJVectorDestroy(*vecs[v]);
+    free(ncols);
+    free(rows);
+    free(cols);
+    free(r);
+    free(zh);
+    free(zo);
+    free(x_own);
     poisson_free(&p);
     omp_set_num_threads(saved_threads);
 }
@@ -945,6 +1160,7 @@ int main(int argc, char **argv)
     test_named_rows();
     test_lent_rows();
     test_own_vcycle();
+    test_own_vcycle_ranks();
     test_split_layout();
     test_split_view();
     test_pattern_hash();

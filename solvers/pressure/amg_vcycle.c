@@ -365,8 +365,9 @@ void mf_amg_vcycle_free(mf_amg_vcycle *v)
  * sweep of relaxType 3 down and 4 up, Gaussian elimination on the coarsest
  * level, weights 1, all points relaxed in order, R = P^T, no additive or
  * smoother variants. */
-static bool cycle_is_ours(hypre_ParAMGData *d)
+bool mf_amg_cycle_is_ours(HYPRE_Solver amg)
 {
+    hypre_ParAMGData *d = (hypre_ParAMGData *)amg;
     const HYPRE_Int *type = hypre_ParAMGDataGridRelaxType(d);
     const HYPRE_Int *sweeps = hypre_ParAMGDataNumGridSweeps(d);
     if (type == NULL || sweeps == NULL || type[1] != 3 || type[2] != 4 || type[3] != 9 ||
@@ -413,8 +414,9 @@ static int copy_interp(amg_level *L, hypre_ParCSRMatrix *P)
     return 0;
 }
 
-static int copy_matrix(mf_split_csr *s, hypre_ParCSRMatrix *A)
+int mf_amg_copy_diag(mf_split_csr *s, HYPRE_ParCSRMatrix par)
 {
+    hypre_ParCSRMatrix *A = (hypre_ParCSRMatrix *)par;
     hypre_CSRMatrix *D = hypre_ParCSRMatrixDiag(A);
     const HYPRE_Int n = hypre_CSRMatrixNumRows(D);
     const HYPRE_Int *I = hypre_CSRMatrixI(D);
@@ -437,7 +439,7 @@ int mf_amg_vcycle_take(HYPRE_Solver amg, mf_amg_vcycle **out)
     hypre_ParAMGData *d = (hypre_ParAMGData *)amg;
     *out = NULL;
     const int nlevels = hypre_ParAMGDataNumLevels(d);
-    if (nlevels < 2 || !cycle_is_ours(d))
+    if (nlevels < 2 || !mf_amg_cycle_is_ours(amg))
         return 0;
     hypre_ParCSRMatrix **A = hypre_ParAMGDataAArray(d), **P = hypre_ParAMGDataPArray(d);
     /* Level 0 is the caller's matrix (not read here: it may be gone). */
@@ -468,7 +470,7 @@ int mf_amg_vcycle_take(HYPRE_Solver amg, mf_amg_vcycle **out)
             P[l] = NULL;
         }
         if (l > 0) {
-            MF_CALL_GOTO(rc, copy_matrix(&L->A, A[l]), fail);
+            MF_CALL_GOTO(rc, mf_amg_copy_diag(&L->A, (HYPRE_ParCSRMatrix)A[l]), fail);
             hypre_ParCSRMatrixDestroy(A[l]);
             A[l] = NULL;
             L->n = L->A.n;

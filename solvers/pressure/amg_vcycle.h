@@ -1,5 +1,6 @@
 /* amg_vcycle.h: a V-cycle of our own over a hierarchy that hypre's BoomerAMG
- * set up, and the PCG around it, for a solve on one MPI rank.
+ * set up, and the PCG around it, for a solve on one MPI rank (amg_vcycle.c)
+ * and on several (amg_vcycle_par.c, declared at the end).
  *
  * Why: on one rank the solve phase of hypre's PCG + BoomerAMG spends its time
  * in loops that add one product at a time into one sum (the matrix-vector
@@ -36,6 +37,7 @@
 #include <stdint.h>
 
 #include "mf_modules.h"
+#include "row_dot.h"
 
 /* A square matrix by rows, the diagonal apart: the off-diagonal entries of
  * row i are [ptr[i], ptr[i + 1] - gap), those of columns below i first
@@ -88,6 +90,14 @@ int mf_split_csr_fine(mf_split_csr *s, const mf_csr *A);
 void mf_split_csr_restore(mf_split_csr *s);
 void mf_split_csr_free(mf_split_csr *s);
 
+/* Row i of A times p (the diagonal included). */
+static inline double mf_split_csr_matvec_dot_row(const mf_split_csr *A, int32_t i, const double *p)
+{
+    const int32_t k = A->ptr[i];
+    return A->diag[i] * p[i] +
+           mf_row_dot(A->col + k, A->val + k, (size_t)(mf_split_end(A, i) - k), p);
+}
+
 /* q = A p; returns p . q. */
 double mf_split_csr_matvec_dot(const mf_split_csr *A, const double *p, double *q);
 
@@ -104,6 +114,66 @@ typedef struct mf_amg_vcycle mf_amg_vcycle;
  * negative on a failure. The hierarchy's first interpolation has one row
  * per unknown of the set-up's matrix (a slot). */
 int mf_amg_vcycle_take(HYPRE_Solver amg, mf_amg_vcycle **out);
+
+/* Shared by the cycle on one rank and on N (amg_vcycle_par.c): whether the
+ * cycle hypre set up is the one written here (relaxType 3 down, 4 up,
+ * Gaussian elimination on the coarsest level, weights 1, R = P^T, ...);
+ * and the copy of a level's diag part (hypre_ParCSRMatrixDiag: this rank's
+ * rows and columns) into the split layout. */
+bool mf_amg_cycle_is_ours(HYPRE_Solver amg);
+int mf_amg_copy_diag(mf_split_csr *s, HYPRE_ParCSRMatrix A);
+
+/* ---- the same cycle and PCG on N ranks (amg_vcycle_par.c) ----------------
+ * Each level's matrix and interpolation as hypre holds them on this rank:
+ * the diag block (split as above for the levels' matrices), the offd block
+ * (columns of other ranks, col_map_offd) and the comm package that moves
+ * their values (hypre_ParCSRMatrixCommPkg). The smoother is relaxType 3 on
+ * N ranks: Gauss-Seidel within the rank's block, Jacobi across ranks (the
+ * offd values exchanged before each sweep), forward from zero down,
+ * backward up (a symmetric cycle); the residual after the down sweep is
+ * -U u - A_offd u_halo; restriction P^T sends the offd contributions back
+ * to their owners (the comm package's transpose, job 2); the coarsest level
+ * is gathered on every rank (LU once a set-up, MPI_Allgatherv of its
+ * right-hand side a cycle). The coarse levels and the interpolations are
+ * read in hypre's hierarchy, which must outlive the cycle (it is kept
+ * whole: the module keeps hypre's solver, whose solve is the fallback). */
+typedef struct mf_amg_par mf_amg_par;
+
+/* Collective: the cycle over amg's hierarchy, set up by hypre on every
+ * rank. *out NULL and *why a reason (the same on every rank) when it is not
+ * one this cycle runs; negative on a failure (agreed over the ranks). */
+int mf_amg_par_take(HYPRE_Solver amg, mf_amg_par **out, const char **why);
+void mf_amg_par_free(mf_amg_par *v);
+
+/* Collective: PCG preconditioned by the cycle for the ParCSR matrix A of
+ * this solve (the fine level: its row partition the first interpolation's),
+ * b and x hypre's vectors of it (x: the initial guess in, the solution
+ * out). Stops as mf_amg_pcg does: the recursion's residual says when to
+ * look, the true ||b - A x|| <= tol * bnorm decides; MF_RETRY (no message)
+ * when max_iter passed or the recursion broke down. *why non-NULL (and 0,
+ * nothing done) when A's diagonal is not positive on some rank: the caller
+ * then runs hypre's PCG. */
+int mf_amg_par_pcg(mf_amg_par *v, HYPRE_ParCSRMatrix A, HYPRE_ParVector b, HYPRE_ParVector x,
+                   double bnorm, double tol, long max_iter, int *iterations, double *rel,
+                   const char **why);
+/* The rows' slots over the ranks (hypre_common.c's slot space): this rank's
+ * slot of each row, its slots [first, first + nslots) of hypre's rows, the
+ * slot of every global row (column), the first slot of each rank (nprocs +
+ * 1 entries). */
+typedef struct mf_par_slots {
+    const int64_t *slot;
+    int64_t nslots, first;
+    const int *of_row;
+    const int64_t *starts;
+} mf_par_slots;
+/* Collective: mf_amg_par_pcg for the caller's rows A in slot space, the
+ * fine level built from them without a hypre matrix (a kept hierarchy's
+ * solve); b, x in the rows' order. */
+int mf_amg_par_pcg_rows(mf_amg_par *v, const mf_csr *A, const mf_par_slots *ps, const double *b,
+                        double *x, double bnorm, double tol, long max_iter, int *iterations,
+                        double *rel, const char **why);
+/* Collective: z = M r, one cycle (for the tests), with A as in mf_amg_par_pcg. */
+int mf_amg_par_apply(mf_amg_par *v, HYPRE_ParCSRMatrix A, HYPRE_ParVector r, HYPRE_ParVector z);
 #endif
 #define MF_AMG_MAX_COARSEST 2000
 

@@ -13,6 +13,7 @@
 #include <inttypes.h>
 #include <limits.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -269,11 +270,13 @@ typedef struct slot_space {
     int64_t first;            /* this rank's first hypre row (0 on one rank) */
     int64_t total;            /* slots of all ranks */
     int *of_row;              /* several ranks: hypre row of each global row */
+    int64_t *starts;          /* several ranks: first slot of each rank (nprocs + 1) */
 } slot_space;
 
 static void slot_space_free(slot_space *ss)
 {
     free(ss->of_row);
+    free(ss->starts);
     memset(ss, 0, sizeof *ss);
 }
 
@@ -326,7 +329,8 @@ static int slot_space_build(const char *who, const mf_csr *A, const mf_row_names
     int64_t *nslots = malloc((size_t)lay->nprocs * sizeof *nslots);
     int *mine = malloc((A->nrows + 1) * sizeof *mine);
     ss->of_row = malloc(((size_t)A->nglobal + 1) * sizeof *ss->of_row);
-    if (nslots == NULL || mine == NULL || ss->of_row == NULL)
+    ss->starts = malloc(((size_t)lay->nprocs + 1) * sizeof *ss->starts);
+    if (nslots == NULL || mine == NULL || ss->of_row == NULL || ss->starts == NULL)
         rc = MF_ERROR(MF_ERR_MEMORY, "%s: out of memory for the slots of %" PRId64 " rows", who,
                       A->nglobal);
     MF_CALL_GOTO(rc, mf_hypre_agree(who, rc), fail);
@@ -337,8 +341,10 @@ static int slot_space_build(const char *who, const mf_csr *A, const mf_row_names
     for (int p = 0; p < lay->nprocs; p++) {
         if (p == rank)
             ss->first = ss->total;
+        ss->starts[p] = ss->total;
         ss->total += nslots[p];
     }
+    ss->starts[lay->nprocs] = ss->total;
     /* Every rank computed the same total: the same decision everywhere. */
     if (ss->total > HYPRE_BIGINT_MAX || ss->total > INT_MAX) {
         rc = MF_ERROR(MF_ERR_INPUT, "%s: %" PRId64 " slots over the ranks exceed hypre's index",
@@ -549,7 +555,7 @@ int mf_hypre_setup_cycle(const char *who, HYPRE_Solver amg, const mf_csr *A,
         HYPRE_BoomerAMGDestroy(amg);
         return MF_ERROR(MF_ERR_MEMORY, "%s: out of memory (%zu rows)", who, A->nrows);
     }
-    const slot_space ss = {rows, 0, rows ? rows->nslots : 0, NULL}; /* one rank */
+    const slot_space ss = {rows, 0, rows ? rows->nslots : 0, NULL, NULL}; /* one rank */
     rc = rows ? check_names(who, A, rows) : 0;
     bool in_place = false; /* hypre's matrix in A's arrays: no copy of A */
     if (rc == 0)
@@ -572,6 +578,134 @@ int mf_hypre_setup_cycle(const char *who, HYPRE_Solver amg, const mf_csr *A,
     free(zero);
     if (rc != 0)
         return mf_error_trace(rc, __FILE__, __LINE__, __func__);
+    return 0;
+}
+
+/* Collective: hypre's PCG with pc on the assembled system (*solver: the
+ * caller destroys it); rep's iterations and set-up time, *t_solve when the
+ * iterations began. */
+static int hypre_pcg_run(const char *who, const mf_hypre_pcg *pcg, const mf_hypre_precond *pc,
+                         const hypre_system *sys, HYPRE_Solver *solver_out, mf_solve_report *rep,
+                         double t_start, double *t_solve)
+{
+    int rc = 0;
+    HYPRE_Solver solver = NULL;
+    MF_HYPRE_CALL(who, rc, done, HYPRE_ParCSRPCGCreate, (MPI_COMM_WORLD, &solver));
+    *solver_out = solver;
+    MF_HYPRE_CALL(who, rc, done, HYPRE_PCGSetTol, (solver, pcg->tolerance));
+    MF_HYPRE_CALL(who, rc, done, HYPRE_PCGSetMaxIter, (solver, (HYPRE_Int)pcg->max_iter));
+    /* Stop on ||r||_2 / ||b||_2, the residual we report, not the
+     * preconditioned norm. */
+    MF_HYPRE_CALL(who, rc, done, HYPRE_PCGSetTwoNorm, (solver, 1));
+    /* Before accepting convergence, recompute r = b - A x (one matvec): the
+     * recursively updated residual drifts from the true one, and we judge
+     * convergence by the true one below. */
+    MF_HYPRE_CALL(who, rc, done, HYPRE_PCGSetRecomputeResidual, (solver, 1));
+    MF_HYPRE_CALL(who, rc, done, HYPRE_PCGSetPrintLevel, (solver, 0));
+    MF_HYPRE_CALL(who, rc, done, HYPRE_PCGSetLogging, (solver, 0));
+    MF_HYPRE_CALL(who, rc, done, HYPRE_ParCSRPCGSetPrecond,
+                  (solver, pc->solve, pc->setup, pc->solver));
+    MF_HYPRE_CALL(who, rc, done, HYPRE_ParCSRPCGSetup, (solver, sys->parA, sys->parb, sys->parx));
+    *t_solve = MPI_Wtime();
+    rep->setup_seconds = *t_solve - t_start;
+
+    /* x holds the caller's initial guess: PCG starts from it. HYPRE_ERROR_CONV
+     * (iteration limit, or a breakdown) is not a library failure: the true
+     * residual decides (the caller's), and the caller may retry. */
+    HYPRE_Int ierr = HYPRE_ParCSRPCGSolve(solver, sys->parA, sys->parb, sys->parx);
+    if (ierr & ~HYPRE_ERROR_CONV) {
+        rc = mf_hypre_error(who, "HYPRE_ParCSRPCGSolve", ierr, __FILE__, __LINE__, __func__);
+        goto done;
+    }
+    HYPRE_ClearAllErrors();
+    HYPRE_Int iterations = 0;
+    MF_HYPRE_CALL(who, rc, done, HYPRE_ParCSRPCGGetNumIterations, (solver, &iterations));
+    rep->iterations = (int)iterations;
+done:
+    return rc;
+}
+
+/* ---- our V-cycle on several ranks ----------------------------------------- */
+
+/* The preconditioner's set-up as PCG calls it, once the hierarchy is set up. */
+static HYPRE_Int setup_done(HYPRE_Solver amg, HYPRE_ParCSRMatrix A, HYPRE_ParVector b,
+                            HYPRE_ParVector x)
+{
+    (void)amg;
+    (void)A;
+    (void)b;
+    (void)x;
+    return 0;
+}
+
+/* Why hypre's PCG runs instead of ours (why NULL: it does not), printed by
+ * rank 0, once a module (pc->told). */
+static void tell_fallback(const char *who, const mf_hypre_precond *pc, const char *why)
+{
+    if (why == NULL || pc->told == NULL || *pc->told)
+        return;
+    int rank = 0;
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    if (rank == 0)
+        fprintf(stderr, "%s: hypre's PCG and V-cycle run instead of ours on several ranks: %s\n",
+                who, why);
+    *pc->told = true;
+}
+
+/* Collective: PCG with our V-cycle over pc's hierarchy (set up here when
+ * new) on the assembled system; *ran false when hypre's PCG is to run
+ * instead (the hierarchy set up, pc->setup then a no-op), the reason
+ * printed once by rank 0. */
+static int par_cycle_solve(const char *who, const mf_hypre_pcg *pcg, mf_hypre_precond *pc,
+                           const hypre_system *sys, double bnorm, mf_solve_report *rep,
+                           double t_start, double *t_solve, bool *ran)
+{
+    int rc = 0;
+    const char *why = NULL;
+    *ran = false;
+    if (pc->setup == HYPRE_BoomerAMGSetup) { /* a new hierarchy */
+        MF_HYPRE_CALL(who, rc, fail, HYPRE_BoomerAMGSetup,
+                      (pc->solver, sys->parA, sys->parb, sys->parx));
+        pc->setup = setup_done;
+        mf_amg_par_free(*pc->par);
+        *pc->par = NULL;
+        MF_CALL(mf_amg_par_take(pc->solver, pc->par, &why));
+    }
+    if (*pc->par) {
+        *t_solve = MPI_Wtime();
+        rep->setup_seconds = *t_solve - t_start;
+        rc = mf_amg_par_pcg(*pc->par, sys->parA, sys->parb, sys->parx, bnorm, pcg->tolerance,
+                            pcg->max_iter, &rep->iterations, &rep->final_residual, &why);
+        if (rc != 0 && rc != MF_RETRY)
+            return mf_error_trace(rc, __FILE__, __LINE__, __func__);
+        *ran = why == NULL;
+    }
+    tell_fallback(who, pc, why);
+    return 0;
+fail:
+    return rc;
+}
+
+/* Collective: PCG with our V-cycle over the kept hierarchy (*pc->par), the
+ * fine level built from the caller's rows in slot space; *ran false (x as
+ * it was) when it cannot run, the reason printed once. */
+static int par_rows_solve(const char *who, const mf_hypre_pcg *pcg, mf_hypre_precond *pc,
+                          const mf_csr *A, const slot_space *ss, const double *b, double *x,
+                          double bnorm, mf_solve_report *rep, double t_start, double *t_solve,
+                          bool *ran)
+{
+    const mf_par_slots ps = {ss->rows->slot, ss->rows->nslots, ss->first, ss->of_row,
+                             ss->starts};
+    const char *why = NULL;
+    *t_solve = MPI_Wtime();
+    rep->setup_seconds = *t_solve - t_start;
+    const int rc = mf_amg_par_pcg_rows(*pc->par, A, &ps, b, x, bnorm, pcg->tolerance,
+                                       pcg->max_iter, &rep->iterations, &rep->final_residual,
+                                       &why);
+    if (rc != 0 && rc != MF_RETRY)
+        return mf_error_trace(rc, __FILE__, __LINE__, __func__);
+    *ran = why == NULL;
+    tell_fallback(who, pc, why);
     return 0;
 }
 
@@ -698,42 +832,31 @@ int mf_hypre_pcg_solve(const mf_hypre_pcg *pcg, const mf_csr *A, const double *b
         }
         /* Not a hierarchy our cycle runs: hypre's PCG. */
     }
-    MF_CALL_GOTO(rc, assemble(who, A, &ss, b, x, &sys), done);
     rc = pcg->precond_prepare(pcg->ctx, A, rows, &pc);
     prepared = rc == 0;
     MF_CALL_GOTO(rc, mf_hypre_agree(who, rc), done);
 
-    MF_HYPRE_CALL(who, rc, done, HYPRE_ParCSRPCGCreate, (MPI_COMM_WORLD, &solver));
-    MF_HYPRE_CALL(who, rc, done, HYPRE_PCGSetTol, (solver, pcg->tolerance));
-    MF_HYPRE_CALL(who, rc, done, HYPRE_PCGSetMaxIter, (solver, (HYPRE_Int)pcg->max_iter));
-    /* Stop on ||r||_2 / ||b||_2, the residual we report, not the
-     * preconditioned norm. */
-    MF_HYPRE_CALL(who, rc, done, HYPRE_PCGSetTwoNorm, (solver, 1));
-    /* Before accepting convergence, recompute r = b - A x (one matvec): the
-     * recursively updated residual drifts from the true one, and we judge
-     * convergence by the true one below. */
-    MF_HYPRE_CALL(who, rc, done, HYPRE_PCGSetRecomputeResidual, (solver, 1));
-    MF_HYPRE_CALL(who, rc, done, HYPRE_PCGSetPrintLevel, (solver, 0));
-    MF_HYPRE_CALL(who, rc, done, HYPRE_PCGSetLogging, (solver, 0));
-    MF_HYPRE_CALL(who, rc, done, HYPRE_ParCSRPCGSetPrecond, (solver, pc.solve, pc.setup, pc.solver));
-    MF_HYPRE_CALL(who, rc, done, HYPRE_ParCSRPCGSetup, (solver, sys.parA, sys.parb, sys.parx));
-    const double t_solve = MPI_Wtime();
-    rep->setup_seconds = t_solve - t_start;
-
-    /* x holds the caller's initial guess: PCG starts from it. HYPRE_ERROR_CONV
-     * (iteration limit, or a breakdown) is not a library failure: the true
-     * residual below decides, and the caller may retry. */
-    HYPRE_Int ierr = HYPRE_ParCSRPCGSolve(solver, sys.parA, sys.parb, sys.parx);
-    if (ierr & ~HYPRE_ERROR_CONV) {
-        rc = mf_hypre_error(who, "HYPRE_ParCSRPCGSolve", ierr, __FILE__, __LINE__, __func__);
-        goto done;
+    double t_solve = MPI_Wtime();
+    bool ran = false; /* our PCG and V-cycle on several ranks */
+    if (lay.nprocs > 1 && pc.par != NULL && *pc.par != NULL && pc.setup != HYPRE_BoomerAMGSetup &&
+        ss.rows != NULL)
+        /* A kept hierarchy: the fine level from the caller's rows, no hypre matrix. */
+        MF_CALL_GOTO(rc, par_rows_solve(who, pcg, &pc, A, &ss, b, x, bnorm, rep, t_start,
+                                        &t_solve, &ran),
+                     done);
+    if (!ran) {
+        MF_CALL_GOTO(rc, assemble(who, A, &ss, b, x, &sys), done);
+        if (lay.nprocs > 1 && pc.par != NULL)
+            MF_CALL_GOTO(rc, par_cycle_solve(who, pcg, &pc, &sys, bnorm, rep, t_start, &t_solve,
+                                             &ran),
+                         done);
+        if (!ran)
+            MF_CALL_GOTO(rc,
+                         hypre_pcg_run(who, pcg, &pc, &sys, &solver, rep, t_start, &t_solve),
+                         done);
+        MF_HYPRE_CALL(who, rc, done, HYPRE_IJVectorGetValues,
+                      (sys.x, (HYPRE_Int)A->nrows, sys.rows, x));
     }
-    HYPRE_ClearAllErrors();
-    HYPRE_Int iterations = 0;
-    MF_HYPRE_CALL(who, rc, done, HYPRE_ParCSRPCGGetNumIterations, (solver, &iterations));
-    rep->iterations = (int)iterations;
-    MF_HYPRE_CALL(who, rc, done, HYPRE_IJVectorGetValues,
-                  (sys.x, (HYPRE_Int)A->nrows, sys.rows, x));
 
     /* The honest number: ||b - A x|| / ||b|| from the caller's matrix. */
     MF_CALL_GOTO(rc, residual_norm(who, A, b, x, &lay, &rnorm), done);

@@ -35,13 +35,19 @@
  *    is one for all (may_keep): a rank whose particles changed (migration,
  *    reordering) makes every rank set a new hierarchy up, since hypre's
  *    set-up is collective and the hierarchy's row partition is the ranks'
- *    slot counts. The solve is then hypre's PCG (our V-cycle runs on one
- *    rank only).
+ *    slot counts.
  *  - reuseSetup > 0 keeps the hierarchy for that many further solves as
  *    long as the matrix size and sparsity pattern do not change (the
  *    implicit viscosity: one matrix, a solve per velocity component).
  * A kept hierarchy that fails to converge is rebuilt and the solve repeated
  * once from the same initial guess.
+ *
+ * ownCycle (default yes) with relaxType 3: hypre sets the hierarchy up, our
+ * PCG and V-cycle run it (amg_vcycle.h): on one rank a copy of it, on
+ * several hypre's levels read in place with their comm packages
+ * (amg_vcycle_par.c; hypre's solver is kept, its own PCG and cycle the
+ * fallback when ours cannot run, the reason printed once). no: hypre's PCG
+ * and V-cycle.
  */
 #define MF_PRESSURE_HYPRE_INTERNAL
 #include "pressure_hypre.h"
@@ -49,6 +55,8 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include <mpi.h>
 
 #include "amg_vcycle.h"
 #include "mf_error.h"
@@ -61,6 +69,10 @@ typedef struct pcg_boomeramg {
      * (amg), or on one rank the copy our V-cycle runs (cycle). */
     HYPRE_Solver amg;
     mf_amg_vcycle *cycle;
+    /* On several ranks: our V-cycle over amg's hierarchy (NULL: hypre's
+     * cycle serves), and whether the reason it did not was printed. */
+    mf_amg_par *par;
+    bool told;
     bool reused;       /* the current solve reuses amg */
     long setups;       /* hierarchies set up so far (mf_solve_report.setups) */
     /* reuseSetup: the pattern amg was set up with, the solves it may serve. */
@@ -97,6 +109,9 @@ static const mf_param params[] = {
      "16 Chebyshev, 18 l1 Jacobi"},
     {"reuseSetup", MF_PARAM_INT, "0", 0, 1000, NULL, P(reuse_setup),
      "further solves that may reuse the AMG hierarchy while the pattern is unchanged (0 = never)"},
+    {"ownCycle", MF_PARAM_BOOL, "yes", MF_NO_RANGE, NULL, P(own_cycle),
+     "relaxType 3: run our own PCG and V-cycle over the hierarchy hypre set up (on one rank "
+     "and on several; no: hypre's PCG and V-cycle)"},
     {"reuseHierarchy", MF_PARAM_BOOL, "yes", MF_NO_RANGE, NULL, P(reuse_hierarchy),
      "keep the AMG hierarchy across solves whose rows the caller names (the MPS pressure "
      "equation), rebuilding it when the rows change meaning or the iterations grow"},
@@ -167,6 +182,8 @@ static int pcg_boomeramg_create(const void *settings, void **data)
 
 static void discard_hierarchy(pcg_boomeramg *d)
 {
+    mf_amg_par_free(d->par); /* reads amg's levels: first */
+    d->par = NULL;
     if (d->amg)
         HYPRE_BoomerAMGDestroy(d->amg);
     d->amg = NULL;
@@ -251,16 +268,16 @@ static bool may_keep(const pcg_boomeramg *d, const mf_row_names *rows)
     return mf_hypre_all(may_keep_here(d, rows));
 }
 
-static int precond_prepare(void *ctx, const mf_csr *A, const mf_row_names *rows, mf_hypre_precond *pc)
+static int prepare_hypre(pcg_boomeramg *d, const mf_csr *A, const mf_row_names *rows,
+                         mf_hypre_precond *pc)
 {
-    pcg_boomeramg *d = ctx;
     d->reused = false;
     if (d->cycle) /* kept for our V-cycle: of no use to hypre's */
         discard_hierarchy(d);
     if (rows && d->s.reuse_hierarchy) {
         if (may_keep(d, rows)) {
             d->reused = true;
-            *pc = (mf_hypre_precond){HYPRE_BoomerAMGSolve, keep_hierarchy, d->amg};
+            *pc = (mf_hypre_precond){HYPRE_BoomerAMGSolve, keep_hierarchy, d->amg, NULL, NULL};
             return 0;
         }
         discard_hierarchy(d);
@@ -270,7 +287,7 @@ static int precond_prepare(void *ctx, const mf_csr *A, const mf_row_names *rows,
         d->nslots = rows->nslots;
         d->epoch = rows->epoch;
         d->first_iterations = -1;
-        *pc = (mf_hypre_precond){HYPRE_BoomerAMGSolve, HYPRE_BoomerAMGSetup, d->amg};
+        *pc = (mf_hypre_precond){HYPRE_BoomerAMGSolve, HYPRE_BoomerAMGSetup, d->amg, NULL, NULL};
         return 0;
     }
     if (d->slot_space) /* set up in slot space: of no use to a system in rows */
@@ -281,7 +298,7 @@ static int precond_prepare(void *ctx, const mf_csr *A, const mf_row_names *rows,
         if (d->amg && d->reuses_left > 0 && pattern == d->pattern) {
             d->reuses_left--;
             d->reused = true;
-            *pc = (mf_hypre_precond){HYPRE_BoomerAMGSolve, keep_hierarchy, d->amg};
+            *pc = (mf_hypre_precond){HYPRE_BoomerAMGSolve, keep_hierarchy, d->amg, NULL, NULL};
             return 0;
         }
         discard_hierarchy(d);
@@ -290,7 +307,24 @@ static int precond_prepare(void *ctx, const mf_csr *A, const mf_row_names *rows,
     MF_CALL(mf_boomeramg_create(&d->s, &d->amg));
     d->setups++;
     d->reuses_left = d->s.reuse_setup;
-    *pc = (mf_hypre_precond){HYPRE_BoomerAMGSolve, HYPRE_BoomerAMGSetup, d->amg};
+    *pc = (mf_hypre_precond){HYPRE_BoomerAMGSolve, HYPRE_BoomerAMGSetup, d->amg, NULL, NULL};
+    return 0;
+}
+
+/* hypre's hierarchy for this solve (kept or new, under reuseHierarchy's and
+ * reuseSetup's rules); on several ranks with relaxType 3 and ownCycle, run
+ * by our PCG and V-cycle (hypre_common.c takes it after the set-up). */
+static int precond_prepare(void *ctx, const mf_csr *A, const mf_row_names *rows,
+                           mf_hypre_precond *pc)
+{
+    pcg_boomeramg *d = ctx;
+    MF_CALL(prepare_hypre(d, A, rows, pc));
+    int nprocs = 1;
+    MPI_Comm_size(MPI_COMM_WORLD, &nprocs);
+    if (nprocs > 1 && d->s.own_cycle && d->s.relax_type == 3) {
+        pc->par = &d->par;
+        pc->told = &d->told;
+    }
     return 0;
 }
 
@@ -304,7 +338,8 @@ static int cycle_prepare(void *ctx, const mf_csr *A, const mf_row_names *rows,
     pcg_boomeramg *d = ctx;
     *cycle = NULL;
     d->reused = false;
-    if (d->s.relax_type != 3 || d->amg != NULL) /* hypre's own, or a hierarchy of hypre's kept */
+    /* hypre's own cycle asked for, or a hierarchy of hypre's kept */
+    if (d->s.relax_type != 3 || !d->s.own_cycle || d->amg != NULL)
         return 0;
     if (rows && d->s.reuse_hierarchy) {
         if (d->cycle && may_keep(d, rows)) {

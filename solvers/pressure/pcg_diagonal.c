@@ -55,7 +55,7 @@ static int precond_prepare(void *ctx, const mf_csr *A, const mf_row_names *rows,
                             " is not positive (the matrix must be SPD)",
                             module_name, diag, row);
     }
-    *pc = (mf_hypre_precond){HYPRE_ParCSRDiagScale, HYPRE_ParCSRDiagScaleSetup, NULL};
+    *pc = (mf_hypre_precond){HYPRE_ParCSRDiagScale, HYPRE_ParCSRDiagScaleSetup, NULL, NULL, NULL};
     return 0;
 }
 

@@ -34,6 +34,7 @@ typedef struct mf_pcg_boomeramg_settings {
     long relax_type;         /* smoother, must be symmetric (8 = l1 symmetric Gauss-Seidel) */
     long reuse_setup;        /* solves that may reuse one AMG hierarchy while the pattern is
                                 unchanged (0 = rebuild each) */
+    bool own_cycle;          /* relaxType 3: our V-cycle and PCG over hypre's hierarchy */
     bool reuse_hierarchy;    /* named rows (mf_row_names): keep the hierarchy across solves */
     double rebuild_ratio;    /* ... until a solve takes this many times the iterations of the
                                 hierarchy's first */
@@ -62,12 +63,21 @@ extern const mf_pressure_ops mf_pressure_PCG_diagonal;
 
 /* Our V-cycle over a hierarchy of hypre's (amg_vcycle.h). */
 typedef struct mf_amg_vcycle mf_amg_vcycle;
+typedef struct mf_amg_par mf_amg_par;
 
 /* The preconditioner PCG uses: hypre's (solve, setup, data) triple. */
 typedef struct mf_hypre_precond {
     HYPRE_PtrToParSolverFcn solve;
     HYPRE_PtrToParSolverFcn setup;
     HYPRE_Solver solver; /* may be NULL (diagonal scaling needs no data) */
+    /* Optional, several ranks (NULL: hypre's PCG): where the module keeps
+     * our V-cycle over solver's hierarchy (amg_vcycle.h, mf_amg_par), which
+     * then runs in our PCG. setup HYPRE_BoomerAMGSetup: a new hierarchy,
+     * set up and taken (*par) before the solve; else *par is the kept one's
+     * (NULL: hypre's PCG). told: whether the reason for falling back on
+     * hypre's PCG was printed (once a module). */
+    mf_amg_par **par;
+    bool *told;
 } mf_hypre_precond;
 
 /* One PCG solve as a module describes it. */
