@@ -25,14 +25,17 @@
  *                 available potential energy) reaches 0.03;
  *   availableEnergy  kinetic energy above what the fluid can have at all:
  *                 KE0 + P + A + max(W_o, 0), P the potential energy the
- *                 fluid's start has above the same fluid laid level on the
- *                 container's floor (the heaviest fluid lowest; an upper
- *                 bound of what gravity can give it), A as above, W_o the
- *                 work of the force modules other than gravity (W minus
- *                 gravity's, from the g the gravity module records in
- *                 mf_sim.gravity), by more than availableEnergyTolerance of
- *                 that budget plus M |g| l0 (the layer's resolution: a tank
- *                 at rest has P = 0). It applies to a fluid in one tank box
+ *                 fluid's start has above the least it can reach (the same
+ *                 fluid laid level on the container's floor, the densest
+ *                 lowest; or where it is when it has settled below that, a
+ *                 compacted fluid), A as above, W_o the work of the force
+ *                 modules other than gravity (W minus gravity's, from the g
+ *                 the gravity module records in mf_sim.gravity), by more
+ *                 than availableEnergyTolerance of that budget plus E, the
+ *                 level layers' own energy above the floor (M |g| H / 2 for
+ *                 one fluid H deep: a tank at rest has P = 0, and its
+ *                 particles' jitter, 0.39 J in the 157 J of hydrostatic2D,
+ *                 is no burst). It applies to a fluid in one tank box
  *                 with a closed floor and closed sides (no periodic axis,
  *                 no outlet), at rest or translating, gravity along an axis,
  *                 no inlets, outlets or nozzles; otherwise the log says once
@@ -62,7 +65,7 @@ typedef struct mf_watch_settings {
     double energy_tolerance;  /* fraction of the energy scale */
     double density_collapse;  /* fraction of n0 */
     bool available_energy;    /* the availableEnergy criterion on */
-    double available_tolerance; /* fraction of the available energy (and M |g| l0) */
+    double available_tolerance; /* fraction of the available energy (and E) */
 } mf_watch_settings;
 
 /* The container's floor for the availableEnergy criterion
@@ -98,9 +101,9 @@ typedef struct mf_watch {
     /* availableEnergy: the floor, the fluid's potential energy and gravity's
      * momentum at the start, gravity's work (from the momentum, the
      * trapezoidal rule as W) and the step's candidates, and the peak
-     * (KE - budget) / (budget + M |g| l0) of an accepted step. */
+     * (KE - budget) / (budget + E) of an accepted step. */
     mf_watch_floor floor;
-    double pe0, mass_g_l0;
+    double pe0, rest_energy; /* rest_energy: E, the level layers' above the floor */
     double momentum[3], next_momentum[3];
     double gravity_work, next_gravity_work;
     double next_available, peak_available, peak_available_time;

@@ -29,7 +29,8 @@ const mf_param mf_watch_params[] = {
      "walls, surface tension and the forces other than gravity"},
     {"availableEnergyTolerance", MF_PARAM_SCALAR, "0.05", 1e-6, 1e6, NULL,
      offsetof(mf_watch_settings, available_tolerance),
-     "kinetic energy above the available energy, as a fraction of it plus M |g| l0"},
+     "kinetic energy above the available energy, as a fraction of it plus the energy of the "
+     "fluid laid level (its layers' weight times their mid-height above the floor)"},
 };
 const size_t mf_watch_nparams = sizeof mf_watch_params / sizeof mf_watch_params[0];
 
@@ -333,7 +334,7 @@ static void available_start(mf_watch *w, const mf_sim *sim)
         return;
     }
     w->pe0 = mf_watch_fluid_pe(sim, &w->floor);
-    w->mass_g_l0 = mf_watch_mass_g_l0(sim, &w->floor);
+    mf_watch_level_pe(sim, &w->floor, &w->rest_energy);
     momentum(sim, w->momentum);
     w->gravity_work = 0;
 }
@@ -355,10 +356,16 @@ static int check_available(mf_watch *w, const mf_sim *sim, double dt, double ke,
                                ? w->gravity_work
                                : w->gravity_work + 0.5 * (gp0 + gp1) * dt;
     const double other = w->next_work - w->next_gravity_work;
-    const double potential = fmax(w->pe0 - mf_watch_level_pe(sim, &w->floor), 0);
+    /* The least potential energy the fluid can reach: the level layers, or
+     * where it is when it has settled below them (a fluid that compacts,
+     * particles closer than l0 at the bottom of a resting tank, releases
+     * that part too: energy conservation, KE <= KE0 + PE0 - PE). */
+    const double lowest =
+        fmin(mf_watch_level_pe(sim, &w->floor, NULL), mf_watch_fluid_pe(sim, &w->floor));
+    const double potential = fmax(w->pe0 - lowest, 0);
     const double unreported = w->wall_scale + w->surface_scale; /* A */
     const double budget = w->ke0 + potential + unreported + fmax(other, 0);
-    const double scale = budget + w->mass_g_l0;
+    const double scale = budget + w->rest_energy;
     const double excess = ke - budget;
     w->next_available = excess / scale;
     w->next_time = sim->time;
@@ -375,11 +382,12 @@ static int check_available(mf_watch *w, const mf_sim *sim, double dt, double ke,
                     "available to it %g J (above the fluid laid level on the floor of wall box "
                     "%zu) plus %g J that moving walls and surface tension and %g J that the "
                     "forces other than gravity may give, by %g J, more than "
-                    "availableEnergyTolerance %g of that and M |g| l0 (%g J); fastest: fluid "
+                    "availableEnergyTolerance %g of that and the level fluid's own %g J (%g J); "
+                    "fastest: fluid "
                     "particle id %lld at (%g %g %g), %g m/s",
                     sim->time, sim->step, ke, w->ke0, potential,
                     mf_scene_tank_number(sim, w->floor.tank), unreported, fmax(other, 0), excess,
-                    w->s.available_tolerance, scale, (long long)f.id, x[0], x[1], x[2], speed);
+                    w->s.available_tolerance, w->rest_energy, scale, (long long)f.id, x[0], x[1], x[2], speed);
 }
 
 /* On several ranks the local checks (nonFinite, throughWall) are agreed on
@@ -433,6 +441,6 @@ void mf_watch_report(const mf_watch *w, mf_log *log)
         mf_log_printf(log, MF_LOG_QUIET,
                       "Watch: availableEnergy: kinetic energy above its start, the available "
                       "potential energy and the other work by at most %.3g of them and "
-                      "M |g| l0 (t = %g; availableEnergyTolerance %g)\n",
+                      "the level fluid's energy (t = %g; availableEnergyTolerance %g)\n",
                       w->peak_available, w->peak_available_time, w->s.available_tolerance);
 }

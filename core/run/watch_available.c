@@ -128,7 +128,7 @@ static void by_density(const mf_sim *sim, int *order)
     }
 }
 
-double mf_watch_level_pe(const mf_sim *sim, const mf_watch_floor *f)
+double mf_watch_level_pe(const mf_sim *sim, const mf_watch_floor *f, double *above_floor)
 {
     const mf_particles *p = sim->p;
     const int ff = mf_particles_field_index(p, "FluidId");
@@ -140,7 +140,8 @@ double mf_watch_level_pe(const mf_sim *sim, const mf_watch_floor *f)
     const mf_wall *w = &sim->walls->w[f->tank];
     /* The floor's height now: the face g points at, moved with the tank. */
     const double face = f->up > 0 ? w->min[f->axis] : w->max[f->axis];
-    double z = f->up * (face + w->state.d[f->axis]);
+    const double z_floor = f->up * (face + w->state.d[f->axis]);
+    double z = z_floor, mass = 0;
     const double vol = sim->dim == 3 ? sim->l0 * sim->l0 * sim->l0 : sim->l0 * sim->l0;
     int order[MF_MAX_FLUIDS];
     by_density(sim, order);
@@ -149,19 +150,10 @@ double mf_watch_level_pe(const mf_sim *sim, const mf_watch_floor *f)
         const int fl = order[k];
         const double thick = count[fl] * vol / f->area;
         pe += count[fl] * vol * sim->fluid[fl].rho * f->g * (z + 0.5 * thick);
+        mass += count[fl] * vol * sim->fluid[fl].rho;
         z += thick;
     }
+    if (above_floor)
+        *above_floor = pe - mass * f->g * z_floor;
     return pe;
-}
-
-double mf_watch_mass_g_l0(const mf_sim *sim, const mf_watch_floor *f)
-{
-    const mf_particles *p = sim->p;
-    const int ff = mf_particles_field_index(p, "FluidId");
-    double m = 0;
-    for (size_t i = 0; i < p->n_owned; i++)
-        if (p->kind[i] == MF_FLUID)
-            m += mf_sim_particle_mass(sim, ff, i);
-    mf_parallel_sum(sim->par, &m, 1);
-    return m * f->g * sim->l0;
 }

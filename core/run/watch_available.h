@@ -18,9 +18,10 @@ double mf_watch_fluid_pe(const mf_sim *sim, const mf_watch_floor *f);
 /* The potential energy of the fluid of every rank laid level on the floor
  * where it is now, each fluid a layer of its volume (particles times l0^d,
  * mass / rho) over the floor's area, the densest lowest: the least a fluid
- * in this container can have (obstacles only raise it), heights as above. */
-double mf_watch_level_pe(const mf_sim *sim, const mf_watch_floor *f);
-/* M |g| l0, M the fluid's mass on every rank. */
-double mf_watch_mass_g_l0(const mf_sim *sim, const mf_watch_floor *f);
+ * in this container can have (obstacles only raise it), heights as above;
+ * *above_floor (may be NULL): the part of it above the floor, sum over the
+ * layers of M_k |g| times the height of their middle (M |g| H / 2 for one
+ * fluid H deep), the energy scale of the fluid at rest in this tank. */
+double mf_watch_level_pe(const mf_sim *sim, const mf_watch_floor *f, double *above_floor);
 
 #endif
