@@ -339,7 +339,7 @@ static void available_start(mf_watch *w, const mf_sim *sim)
     w->gravity_work = 0;
 }
 
-/* KE <= KE0 + P + A + max(W_o, 0) (mf_watch.h): P = PE0 - PE_level, W_o
+/* KE <= KE0 + P + A + max(W_o, 0) (mf_watch.h): P = PE0 - min(PE_level, PE), W_o
  * the forces' work W less gravity's, g . sum m u integrated as W is (the
  * trapezoidal rule in u; none in a step whose forces did not run). ke is
  * check_energy's, w->next_work this step's W (first: the start, no work). */
@@ -382,19 +382,19 @@ static int check_available(mf_watch *w, const mf_sim *sim, double dt, double ke,
                     "available to it %g J (above the fluid laid level on the floor of wall box "
                     "%zu) plus %g J that moving walls and surface tension and %g J that the "
                     "forces other than gravity may give, by %g J, more than "
-                    "availableEnergyTolerance %g of that and the level fluid's own %g J (%g J); "
-                    "fastest: fluid "
-                    "particle id %lld at (%g %g %g), %g m/s",
+                    "availableEnergyTolerance %g of %g J (that plus the level fluid's own %g J); "
+                    "fastest: fluid particle id %lld at (%g %g %g), %g m/s",
                     sim->time, sim->step, ke, w->ke0, potential,
                     mf_scene_tank_number(sim, w->floor.tank), unreported, fmax(other, 0), excess,
-                    w->s.available_tolerance, w->rest_energy, scale, (long long)f.id, x[0], x[1], x[2], speed);
+                    w->s.available_tolerance, scale, w->rest_energy, (long long)f.id, x[0], x[1],
+                    x[2], speed);
 }
 
 /* On several ranks the local checks (nonFinite, throughWall) are agreed on
  * once, so that every rank reports the same criterion and particle and none
- * goes on to the collective checks alone; those (densityCollapse, energy)
- * decide from sums over the ranks, the same on every rank, and name the
- * particle on every rank. */
+ * goes on to the collective checks alone; those (densityCollapse, energy,
+ * availableEnergy) decide from sums over the ranks, the same on every rank,
+ * and name the particle on every rank. */
 int mf_watch_check(mf_watch *w, const mf_sim *sim, double dt)
 {
     int rc = check_non_finite(sim);
