@@ -133,9 +133,15 @@ peak=$(sed -n 's/^Watch: availableEnergy: .* by at most \([^ ]*\) of them.*(t = 
 # excess reached 0.18 of it, above the default 0.02, and a plain Couette
 # start-up would stop as "unstable").
 rm -rf "$dir/couette"; cp -r "$tutorial/../couette2D" "$dir/couette"; rm -rf "$dir/couette/output"
-"$mpsflow" -case "$dir/couette" -quiet > "$dir/log" 2>&1 && grep -q "^status *completed;" "$dir/couette/output/runSummary" &&
+"$mpsflow" -case "$dir/couette" > "$dir/log" 2>&1 && grep -q "^status *completed;" "$dir/couette/output/runSummary" &&
     { echo "ok   moving lid: completed with the default energyTolerance"; passed=$((passed + 1)); } ||
     { fail "moving lid: stopped"; grep FATAL "$dir/log" | head -2; }
+# Without gravity there is no potential energy to bound the kinetic energy
+# by: the availableEnergy criterion says once that it does not apply.
+[ "$(grep -c '^Watch: no availableEnergy check: no gravity$' "$dir/log")" -eq 1 ] &&
+    ! grep -q "^Watch: availableEnergy:" "$dir/log" &&
+    { echo "ok   no gravity: the log says once that availableEnergy does not apply"; passed=$((passed + 1)); } ||
+    fail "no gravity: no single 'Watch: no availableEnergy check: no gravity' line"
 
 echo "$passed passed, $failed failed"
 [ $failed -eq 0 ]
