@@ -90,6 +90,13 @@ trip "plain scheme blowing up" energy
 fresh; add_force "kickAt 0.02; kick (3 0 0);"
 printf 'watch { energyTolerance 1e6; }\n' >> "$dir/case/system/controlDict"
 trip "energy from no source" availableEnergy -endTime 0.1
+# The budget by hand: the 125 kg column (25 x 50 particles at 0.01 m) drops
+# its centroid from 0.25 m to the middle of a 0.0625 m layer on the 2 m
+# floor: 125 x 9.81 x (0.25 - 0.03125) = 268.242 J; the layer's own energy
+# 125 x 9.81 x 0.03125 = 38.3203 J.
+grep -q "available to it 268.242 J .* the level fluid's own 38.3203 J" "$dir/log" &&
+    { echo "ok   energy from no source: the available 268.242 J and the layer's 38.3203 J as by hand"; passed=$((passed + 1)); } ||
+    fail "energy from no source: not the hand's 268.242 J available and 38.3203 J of the layer"
 grep -q "back at the last good state, written as a snapshot" "$dir/log" &&
     ls "$dir"/case/output/snapshot_*.h5 > /dev/null 2>&1 ||
     fail "energy from no source: the last good state was not kept as a snapshot"
