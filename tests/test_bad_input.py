@@ -404,7 +404,7 @@ EXPECTED.update({
     'unknown function type':
         "--> mpsflow FATAL ERROR: {case}/system/controlDict:29:5: function 'energy': unknown functionObject module 'kinetic'; valid functionObject modules: surface, kineticEnergy",
     'watch: unknown key':
-        "--> mpsflow FATAL ERROR: {case}/system/controlDict:35:9: unknown key 'energyTol' in 'watch'; valid keys: enabled, energyTolerance, densityCollapse",
+        "--> mpsflow FATAL ERROR: {case}/system/controlDict:35:9: unknown key 'energyTol' in 'watch'; valid keys: enabled, energyTolerance, densityCollapse, availableEnergy, availableEnergyTolerance",
     'watch: out of range':
         "--> mpsflow FATAL ERROR: {case}/system/controlDict:35:9: key 'densityCollapse': 2 is out of range [0, 1] (mean fluid number density below this fraction of n0 means the fluid blew apart)",
     'unbalanced brace':

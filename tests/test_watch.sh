@@ -83,6 +83,31 @@ grep -q "scheme          paper;" "$dir/case/system/solverDict" || { echo "FAIL c
 sed -i 's/^maxRetries.*//' "$dir/case/system/controlDict"; printf 'maxRetries 0;\n' >> "$dir/case/system/controlDict"
 trip "plain scheme blowing up" energy
 
+# Kinetic energy from nothing: from t = 0.02 every step ends with 3 m/s
+# added to the fluid (the fault's kick, no force: no work), far above all
+# the column can have (its start, its available potential energy). The
+# energy criterion is held off to see the availableEnergy one catch it.
+fresh; add_force "kickAt 0.02; kick (3 0 0);"
+printf 'watch { energyTolerance 1e6; }\n' >> "$dir/case/system/controlDict"
+trip "energy from no source" availableEnergy -endTime 0.1
+# The budget by hand: the 125 kg column (25 x 50 particles at 0.01 m) drops
+# its centroid from 0.25 m to the middle of a 0.0625 m layer on the 2 m
+# floor: 125 x 9.81 x (0.25 - 0.03125) = 268.242 J; the layer's own energy
+# 125 x 9.81 x 0.03125 = 38.3203 J.
+grep -q "available to it 268.242 J .* the level fluid's own 38.3203 J" "$dir/log" &&
+    { echo "ok   energy from no source: the available 268.242 J and the layer's 38.3203 J as by hand"; passed=$((passed + 1)); } ||
+    fail "energy from no source: not the hand's 268.242 J available and 38.3203 J of the layer"
+grep -q "back at the last good state, written as a snapshot" "$dir/log" &&
+    ls "$dir"/case/output/snapshot_*.h5 > /dev/null 2>&1 ||
+    fail "energy from no source: the last good state was not kept as a snapshot"
+# ... and with the criterion off the same two kicked steps go on.
+fresh; add_force "kickAt 0.02; kick (3 0 0);"
+printf 'watch { energyTolerance 1e6; availableEnergy no; }\n' >> "$dir/case/system/controlDict"
+"$mpsflow" -case "$dir/case" -quiet -endTime 0.0215 > "$dir/log" 2>&1 &&
+    ! grep -q "availableEnergy" "$dir/log" &&
+    { echo "ok   availableEnergy no: the kicked run goes on"; passed=$((passed + 1)); } ||
+    { fail "availableEnergy no: the kicked run stopped"; grep -E "FATAL|unstable" "$dir/log" | head -2; }
+
 # A pressure solve held to one PCG iteration at a tolerance it cannot reach.
 fresh; sed -i 's/^\( *\)tolerance .*/\1tolerance 1e-14; maxIter 1;/' "$dir/case/system/solverDict"
 sed -i 's/^maxRetries.*//' "$dir/case/system/controlDict"; printf 'maxRetries 1;\n' >> "$dir/case/system/controlDict"
@@ -102,16 +127,28 @@ set -- $steps
 
 # The log says how close the stable run came to the energy criterion.
 grep -q "^Watch: kinetic energy above its start and the forces' work by at most .* (t = .*; energyTolerance 0.02)" "$dir/log" &&
-    { echo "ok   $(grep '^Watch:' "$dir/log" | cut -c1-120)"; passed=$((passed + 1)); } || fail "no Watch: line in the stable run's log"
+    { echo "ok   $(grep '^Watch:' "$dir/log" | head -1 | cut -c1-120)"; passed=$((passed + 1)); } || fail "no Watch: line in the stable run's log"
+# ... and how close to the availableEnergy criterion, which applies here
+# (one tank, its floor and sides closed) and stays below its tolerance.
+peak=$(sed -n 's/^Watch: availableEnergy: .* by at most \([^ ]*\) of them.*(t = .*; availableEnergyTolerance 0.05)$/\1/p' "$dir/log")
+[ -n "$peak" ] && python3 -c "import sys; sys.exit(not float('$peak') < 0.05)" &&
+    { echo "ok   availableEnergy peak $peak on the stable run"; passed=$((passed + 1)); } ||
+    fail "stable run: no Watch: availableEnergy line below 0.05 ('$peak')"
 
 # A lid drives the fluid: the lid's work is no force module's, and the
 # criterion counts 1/2 M u_w^2 in full (with it only in the scale, the
 # excess reached 0.18 of it, above the default 0.02, and a plain Couette
 # start-up would stop as "unstable").
 rm -rf "$dir/couette"; cp -r "$tutorial/../couette2D" "$dir/couette"; rm -rf "$dir/couette/output"
-"$mpsflow" -case "$dir/couette" -quiet > "$dir/log" 2>&1 && grep -q "^status *completed;" "$dir/couette/output/runSummary" &&
+"$mpsflow" -case "$dir/couette" > "$dir/log" 2>&1 && grep -q "^status *completed;" "$dir/couette/output/runSummary" &&
     { echo "ok   moving lid: completed with the default energyTolerance"; passed=$((passed + 1)); } ||
     { fail "moving lid: stopped"; grep FATAL "$dir/log" | head -2; }
+# Without gravity there is no potential energy to bound the kinetic energy
+# by: the availableEnergy criterion says once that it does not apply.
+[ "$(grep -c '^Watch: no availableEnergy check: no gravity$' "$dir/log")" -eq 1 ] &&
+    ! grep -q "^Watch: availableEnergy:" "$dir/log" &&
+    { echo "ok   no gravity: the log says once that availableEnergy does not apply"; passed=$((passed + 1)); } ||
+    fail "no gravity: no single 'Watch: no availableEnergy check: no gravity' line"
 
 echo "$passed passed, $failed failed"
 [ $failed -eq 0 ]

@@ -136,6 +136,12 @@ typedef struct mf_sim {
     /* Tests only: a hook the calling wrappers offer their results to (no
      * hook: fn NULL). */
     mf_fault_hook fault;
+    /* The uniform gravity the fluid feels, m/s^2: the sum of the g of the
+     * gravity force modules, recorded by their create (solvers/force/
+     * gravity.c); zero without one. Read by the watch's availableEnergy
+     * criterion (core/run/watch_available.c). Last in the struct: plugins
+     * built against the fields above keep their offsets. */
+    double gravity[3];
 } mf_sim;
 
 /* Mass of particle i: rho l0^d of its fluid; fluid_field is the index of

@@ -22,7 +22,24 @@
  *                 on every tutorial the excess stays below 0.005 of the
  *                 scale, while the water/air dam break's burst at its end-wall
  *                 impact (the water's kinetic energy above the column's
- *                 available potential energy) reaches 0.03.
+ *                 available potential energy) reaches 0.03;
+ *   availableEnergy  kinetic energy above what the fluid can have at all:
+ *                 KE0 + P + A + max(W_o, 0), P the potential energy the
+ *                 fluid's start has above the least it can reach (the same
+ *                 fluid laid level on the container's floor, the densest
+ *                 lowest; or where it is when it has settled below that, a
+ *                 compacted fluid), A as above, W_o the work of the force
+ *                 modules other than gravity (W minus gravity's, from the g
+ *                 the gravity module records in mf_sim.gravity), by more
+ *                 than availableEnergyTolerance of that budget plus E, the
+ *                 level layers' own energy above the floor (M |g| H / 2 for
+ *                 one fluid H deep: a tank at rest has P = 0, and its
+ *                 particles' jitter, 0.39 J in the 157 J of hydrostatic2D,
+ *                 is no burst). It applies to a fluid in one tank box
+ *                 with a closed floor and closed sides (no periodic axis,
+ *                 no outlet), at rest or translating, gravity along an axis,
+ *                 no inlets, outlets or nozzles; otherwise the log says once
+ *                 why not (core/run/watch_available.c).
  * A pressure solve that diverges or does not converge is reported by the
  * solver itself, in the same form: `unstable (pressureSolve) at time ...`
  * with the particle of the largest residual (solvers/solver/mps/mps_ppe.c); a step
@@ -47,7 +64,22 @@ typedef struct mf_watch_settings {
     bool enabled;
     double energy_tolerance;  /* fraction of the energy scale */
     double density_collapse;  /* fraction of n0 */
+    bool available_energy;    /* the availableEnergy criterion on */
+    double available_tolerance; /* fraction of the available energy (and E) */
 } mf_watch_settings;
+
+/* The container's floor for the availableEnergy criterion
+ * (watch_available.c): gravity along axis `axis` of magnitude g, heights
+ * measured up (against g), the floor the face of tank box `tank` that g
+ * points at, of area `area` (2-D: its width, per unit depth). */
+typedef struct mf_watch_floor {
+    bool applies;
+    int axis;
+    double up;      /* +1: up is +axis (g points at -axis); -1: the other way */
+    double g;       /* |g|, m/s^2 */
+    size_t tank;    /* its index in sim->walls */
+    double area;
+} mf_watch_floor;
 
 typedef struct mf_watch {
     mf_watch_settings s;
@@ -66,6 +98,15 @@ typedef struct mf_watch {
     double peak_excess;
     double peak_excess_time;
     double next_time;
+    /* availableEnergy: the floor, the fluid's potential energy and gravity's
+     * momentum at the start, gravity's work (from the momentum, the
+     * trapezoidal rule as W) and the step's candidates, and the peak
+     * (KE - budget) / (budget + E) of an accepted step. */
+    mf_watch_floor floor;
+    double pe0, rest_energy; /* rest_energy: E, the level layers' above the floor */
+    double momentum[3], next_momentum[3];
+    double gravity_work, next_gravity_work;
+    double next_available, peak_available, peak_available_time;
 } mf_watch;
 
 extern const mf_param mf_watch_params[];

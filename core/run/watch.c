@@ -10,6 +10,7 @@
 #include "mf_modules.h"
 #include "mf_scene.h"
 #include "mf_walls.h"
+#include "watch_available.h"
 
 const mf_param mf_watch_params[] = {
     {"enabled", MF_PARAM_BOOL, "yes", MF_NO_RANGE, NULL, offsetof(mf_watch_settings, enabled),
@@ -21,6 +22,15 @@ const mf_param mf_watch_params[] = {
     {"densityCollapse", MF_PARAM_SCALAR, "0.5", 0, 1, NULL,
      offsetof(mf_watch_settings, density_collapse),
      "mean fluid number density below this fraction of n0 means the fluid blew apart"},
+    {"availableEnergy", MF_PARAM_BOOL, "yes", MF_NO_RANGE, NULL,
+     offsetof(mf_watch_settings, available_energy),
+     "check that the fluid's kinetic energy stays below its start plus the potential energy "
+     "available to it (above the fluid laid level on the tank's floor) and the work of moving "
+     "walls, surface tension and the forces other than gravity"},
+    {"availableEnergyTolerance", MF_PARAM_SCALAR, "0.05", 1e-6, 1e6, NULL,
+     offsetof(mf_watch_settings, available_tolerance),
+     "kinetic energy above the available energy, as a fraction of it plus the energy of the "
+     "fluid laid level (its layers' weight times their mid-height above the floor)"},
 };
 const size_t mf_watch_nparams = sizeof mf_watch_params / sizeof mf_watch_params[0];
 
@@ -28,6 +38,7 @@ int mf_watch_init(mf_watch *w, const mf_dict *dict, mf_dict *resolved)
 {
     memset(w, 0, sizeof *w);
     w->n_start = -1;
+    w->peak_available = -INFINITY;
     static const char *const extra[] = {NULL};
     MF_CALL(mf_params_apply(mf_watch_params, mf_watch_nparams, dict, extra, &w->s, resolved));
     return 0;
@@ -254,10 +265,11 @@ static double wall_energy(const mf_sim *sim)
     return 0.5 * mass * u2;
 }
 
-static int check_energy(mf_watch *w, const mf_sim *sim, double dt)
+static int check_energy(mf_watch *w, const mf_sim *sim, double dt, double *ke_out)
 {
     double ke = 0, power_start = 0, power_end = 0, mass_acc = 0;
     energy(sim, &ke, &power_start, &power_end, &mass_acc);
+    *ke_out = ke;
     w->wall_scale = fmax(w->wall_scale, wall_energy(sim));
     if (!w->started) { /* the state the run starts from (after its first step) */
         w->started = true;
@@ -293,11 +305,96 @@ static int check_energy(mf_watch *w, const mf_sim *sim, double dt)
                     w->s.energy_tolerance, scale, (long long)f.id, x[0], x[1], x[2], speed);
 }
 
+/* The fluid's momentum sum m u over the ranks: gravity's power is g . it. */
+static void momentum(const mf_sim *sim, double out[3])
+{
+    const mf_particles *p = sim->p;
+    const int ff = mf_particles_field_index(p, "FluidId");
+    out[0] = out[1] = out[2] = 0;
+    for (size_t i = 0; i < p->n_owned; i++)
+        if (p->kind[i] == MF_FLUID) {
+            const double m = mf_sim_particle_mass(sim, ff, i);
+            for (int c = 0; c < 3; c++)
+                out[c] += m * p->vel[3 * i + c];
+        }
+    mf_parallel_sum(sim->par, out, 3);
+}
+
+/* The availableEnergy criterion at the watch's start: the floor (or why
+ * there is none, said once), the fluid's potential energy and momentum. */
+static void available_start(mf_watch *w, const mf_sim *sim)
+{
+    w->floor = (mf_watch_floor){0};
+    if (!w->s.available_energy)
+        return;
+    char why[160];
+    mf_watch_floor_find(sim, &w->floor, why, sizeof why);
+    if (!w->floor.applies) {
+        mf_log_printf(sim->log, MF_LOG_NORMAL, "Watch: no availableEnergy check: %s\n", why);
+        return;
+    }
+    w->pe0 = mf_watch_fluid_pe(sim, &w->floor);
+    mf_watch_level_pe(sim, &w->floor, &w->rest_energy);
+    momentum(sim, w->momentum);
+    w->gravity_work = 0;
+}
+
+/* KE <= KE0 + P + A + max(W_o, 0) (mf_watch.h): P = PE0 - min(PE_level, PE), W_o
+ * the forces' work W less gravity's, g . sum m u integrated as W is (the
+ * trapezoidal rule in u; none in a step whose forces did not run). ke is
+ * check_energy's, w->next_work this step's W (first: the start, no work). */
+static int check_available(mf_watch *w, const mf_sim *sim, double dt, double ke, bool first)
+{
+    if (!w->floor.applies)
+        return 0;
+    const double *g = sim->gravity;
+    momentum(sim, w->next_momentum);
+    const double *p0 = w->momentum, *p1 = w->next_momentum;
+    const double gp0 = g[0] * p0[0] + g[1] * p0[1] + g[2] * p0[2];
+    const double gp1 = g[0] * p1[0] + g[1] * p1[1] + g[2] * p1[2];
+    w->next_gravity_work = first || !sim->forces_record.valid
+                               ? w->gravity_work
+                               : w->gravity_work + 0.5 * (gp0 + gp1) * dt;
+    const double other = w->next_work - w->next_gravity_work;
+    /* The least potential energy the fluid can reach: the level layers, or
+     * where it is when it has settled below them (a fluid that compacts,
+     * particles closer than l0 at the bottom of a resting tank, releases
+     * that part too: energy conservation, KE <= KE0 + PE0 - PE). */
+    const double lowest =
+        fmin(mf_watch_level_pe(sim, &w->floor, NULL), mf_watch_fluid_pe(sim, &w->floor));
+    const double potential = fmax(w->pe0 - lowest, 0);
+    const double unreported = w->wall_scale + w->surface_scale; /* A */
+    const double budget = w->ke0 + potential + unreported + fmax(other, 0);
+    const double scale = budget + w->rest_energy;
+    const double excess = ke - budget;
+    w->next_available = excess / scale;
+    w->next_time = sim->time;
+    if (!(excess > w->s.available_tolerance * scale))
+        return 0;
+    double speed = 0;
+    const size_t i = fastest_fluid(sim, &speed);
+    mf_particle_info f; /* the fastest over the ranks */
+    mf_parallel_argmax(sim->par, &speed, sim->p, i, &f);
+    const double *x = f.x;
+    return MF_ERROR(MF_ERR_NUMERIC,
+                    "unstable (availableEnergy) at time %g, step %ld: the fluid's kinetic energy "
+                    "%g J exceeds all it can have, its start %g J plus the potential energy "
+                    "available to it %g J (above the fluid laid level on the floor of wall box "
+                    "%zu) plus %g J that moving walls and surface tension and %g J that the "
+                    "forces other than gravity may give, by %g J, more than "
+                    "availableEnergyTolerance %g of %g J (that plus the level fluid's own %g J); "
+                    "fastest: fluid particle id %lld at (%g %g %g), %g m/s",
+                    sim->time, sim->step, ke, w->ke0, potential,
+                    mf_scene_tank_number(sim, w->floor.tank), unreported, fmax(other, 0), excess,
+                    w->s.available_tolerance, scale, w->rest_energy, (long long)f.id, x[0], x[1],
+                    x[2], speed);
+}
+
 /* On several ranks the local checks (nonFinite, throughWall) are agreed on
  * once, so that every rank reports the same criterion and particle and none
- * goes on to the collective checks alone; those (densityCollapse, energy)
- * decide from sums over the ranks, the same on every rank, and name the
- * particle on every rank. */
+ * goes on to the collective checks alone; those (densityCollapse, energy,
+ * availableEnergy) decide from sums over the ranks, the same on every rank,
+ * and name the particle on every rank. */
 int mf_watch_check(mf_watch *w, const mf_sim *sim, double dt)
 {
     int rc = check_non_finite(sim);
@@ -307,7 +404,12 @@ int mf_watch_check(mf_watch *w, const mf_sim *sim, double dt)
     if (!w->s.enabled)
         return 0;
     MF_CALL(check_density(w, sim));
-    MF_CALL(check_energy(w, sim, dt));
+    const bool first = !w->started;
+    double ke = 0;
+    MF_CALL(check_energy(w, sim, dt, &ke));
+    if (first)
+        available_start(w, sim);
+    MF_CALL(check_available(w, sim, dt, ke, first));
     return 0;
 }
 
@@ -318,6 +420,14 @@ void mf_watch_accept(mf_watch *w)
         w->peak_excess = w->next_excess;
         w->peak_excess_time = w->next_time;
     }
+    if (w->floor.applies) {
+        w->gravity_work = w->next_gravity_work;
+        memcpy(w->momentum, w->next_momentum, sizeof w->momentum);
+        if (w->next_available > w->peak_available) {
+            w->peak_available = w->next_available;
+            w->peak_available_time = w->next_time;
+        }
+    }
 }
 
 void mf_watch_report(const mf_watch *w, mf_log *log)
@@ -327,4 +437,10 @@ void mf_watch_report(const mf_watch *w, mf_log *log)
                       "Watch: kinetic energy above its start and the forces' work by at most "
                       "%.3g of the energy scale (t = %g; energyTolerance %g)\n",
                       w->peak_excess, w->peak_excess_time, w->s.energy_tolerance);
+    if (w->s.enabled && w->floor.applies && isfinite(w->peak_available))
+        mf_log_printf(log, MF_LOG_QUIET,
+                      "Watch: availableEnergy: kinetic energy above its start, the available "
+                      "potential energy and the other work by at most %.3g of them and "
+                      "the level fluid's energy (t = %g; availableEnergyTolerance %g)\n",
+                      w->peak_available, w->peak_available_time, w->s.available_tolerance);
 }

@@ -16,11 +16,12 @@ static const mf_param gravity_params[] = {
 
 static int gravity_create(const void *settings, mf_sim *sim, void **data)
 {
-    (void)sim;
     gravity_settings *s = malloc(sizeof *s);
     if (!s)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory");
     *s = *(const gravity_settings *)settings;
+    for (int c = 0; c < 3; c++) /* for the watch's available energy (mf_sim.h) */
+        sim->gravity[c] += s->g[c];
     *data = s;
     return 0;
 }

@@ -8,7 +8,10 @@
  *   nanAt T: from time T, the acceleration this force gives the first fluid
  *     particle is NaN (mf_force_accumulate names the force);
  *   solveNanAt T: from time T, every linear solve returns a NaN in its first
- *     row (mf_pressure_solve says which solve).
+ *     row (mf_pressure_solve says which solve);
+ *   kickAt T, kick V: from time T, each step of the solver ends with V (a
+ *     vector, m/s) added to the velocity of every fluid particle: kinetic
+ *     energy from no force, the availableEnergy case of the watch.
  * As a force:
  *   pushAt T, push A: from time T, the first fluid particle is accelerated by
  *     A (a vector) on top of everything else: through a wall if A points at one;
@@ -30,6 +33,7 @@ typedef struct fault_settings {
     double nan_at, solve_nan_at, push_at, push[3];
     double scatter_at, scatter;
     double stable_dt;
+    double kick_at, kick[3];
 } fault_settings;
 
 static const mf_param fault_params[] = {
@@ -45,6 +49,10 @@ static const mf_param fault_params[] = {
      "time from which the fluid is pushed apart"},
     {"scatter", MF_PARAM_SCALAR, "0", 0, 1e12, NULL, offsetof(fault_settings, scatter),
      "rate of the push apart, 1/s^2: a = scatter (x - centroid)"},
+    {"kickAt", MF_PARAM_SCALAR, "1e30", 0, 1e30, NULL, offsetof(fault_settings, kick_at),
+     "time from which every step ends with the fluid's velocity kicked"},
+    {"kick", MF_PARAM_VECTOR, "(0 0 0)", -1e6, 1e6, NULL, offsetof(fault_settings, kick),
+     "velocity added to every fluid particle after each step, m/s"},
     {"stableDt", MF_PARAM_SCALAR, "1e30", 1e-12, 1e30, NULL,
      offsetof(fault_settings, stable_dt), "the largest step this force allows, s"},
 };
@@ -73,18 +81,35 @@ static int fault_hook(void *ctx, const mf_sim *sim, mf_fault_site site, const ch
     return rc;
 }
 
+/* The step's end: the particles are the sim's to change (sim->p is not
+ * const), and a retry of the step restores them. */
+static int kick_hook(void *ctx, const mf_sim *sim, mf_fault_site site, const char *module,
+                     double *values, size_t n, int rc)
+{
+    const fault_settings *s = ctx;
+    rc = fault_hook(ctx, sim, site, module, values, n, rc);
+    if (rc != 0 || site != MF_FAULT_STEP || sim->time < s->kick_at)
+        return rc;
+    mf_particles *p = sim->p;
+    for (size_t i = 0; i < p->n_owned; i++)
+        if (p->kind[i] == MF_FLUID)
+            for (int c = 0; c < 3; c++)
+                p->vel[3 * i + c] += s->kick[c];
+    return rc;
+}
+
 static int fault_create(const void *settings, mf_sim *sim, void **data)
 {
     fault_settings *s = malloc(sizeof *s);
     if (!s)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory");
     *s = *(const fault_settings *)settings;
-    if (s->nan_at < 1e30 || s->solve_nan_at < 1e30) {
+    if (s->nan_at < 1e30 || s->solve_nan_at < 1e30 || s->kick_at < 1e30) {
         if (sim->fault.fn) {
             free(s);
             return MF_ERROR(MF_ERR_INPUT, "fault: another module holds the fault hook");
         }
-        sim->fault.fn = fault_hook;
+        sim->fault.fn = kick_hook;
         sim->fault.ctx = s;
     }
     *data = s;
