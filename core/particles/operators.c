@@ -265,9 +265,13 @@ typedef struct {
 
 /* c_ij (f_j - f_i) w for ncomp components (literals at the call sites, as
  * hl); c_ij = 1, or mu_ij with a pair viscosity; w the weight of eq. 3, or
- * with hl that of the higher-order Laplacian (mf_weight_hl). */
-static inline bool lap_pair_as(void *acc, const void *ctx, const mf_pair *pr, int ncomp, bool mu,
-                               bool hl)
+ * with hl that of the higher-order Laplacian (mf_weight_hl). Always
+ * inlined: with nine callers GCC kept one generic copy, called once a pair
+ * with ncomp, mu and hl tested at run time (a third of the viscous term's
+ * instructions on the bench 2-D case, docs/notes/speed.md). */
+static inline __attribute__((always_inline)) bool lap_pair_as(void *acc, const void *ctx,
+                                                              const mf_pair *pr, int ncomp,
+                                                              bool mu, bool hl)
 {
     const lap_ctx *c = ctx;
     double *a = acc;
