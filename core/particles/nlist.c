@@ -704,6 +704,38 @@ void mf_nlist_sort(mf_nlist *nl, const uint64_t *keys, bool packed)
     }
 }
 
+/* The lists that hold a particle whose cell changed: by symmetry, those of
+ * the moved particles' own neighbours. */
+void mf_nlist_mark_moved(const mf_nlist *nl, const uint64_t *keys, const uint32_t *cell_before,
+                         uint8_t *dirty)
+{
+    const size_t n = nl->n;
+    const uint32_t *start = nl->start, *jl = nl->j;
+    memset(dirty, 0, n);
+    for (size_t j = 0; j < n; j++) /* serial: a few particles change cell a step */
+        if ((uint32_t)(keys[j] >> 32) != cell_before[j])
+            for (uint32_t e = start[j]; e < start[j + 1]; e++)
+                dirty[jl[e]] = 1;
+}
+
+/* Only a marked list can be out of order: the others hold only particles
+ * whose key is the one they were sorted by. */
+void mf_nlist_sort_marked(mf_nlist *nl, const uint64_t *keys, bool packed, const uint8_t *dirty)
+{
+    const long n = (long)nl->n;
+    const uint32_t *start = nl->start;
+    uint32_t *jl = nl->j;
+#pragma omp parallel for schedule(dynamic, 256)
+    for (long i = 0; i < n; i++) {
+        if (!dirty[i])
+            continue;
+        if (packed)
+            sort_one(jl + start[i], start[i + 1] - start[i], keys, true);
+        else
+            sort_one(jl + start[i], start[i + 1] - start[i], keys, false);
+    }
+}
+
 /* ---- filtering ------------------------------------------------------------ */
 
 /* Squared distance of particles i and j, computed as in the list build. */
