@@ -414,6 +414,11 @@ typedef struct {
     int nrows;               /* rows stored per cell */
     size_t *cell_word;       /* ncells + 1 word offsets, or NULL: no bits */
     uint64_t *bits;
+    /* The candidate ranges of each cell, found once by the plan pass for the
+     * count and fill passes: at cell_ranges + c * range_slots, their number,
+     * then (begin, end) of each. */
+    uint32_t *cell_ranges;
+    size_t range_slots;
 } list_build;
 
 static inline void load_position(const pair_test *t, size_t k, double xi[3])
@@ -423,24 +428,28 @@ static inline void load_position(const pair_test *t, size_t k, double xi[3])
     xi[2] = t->sz[k];
 }
 
-/* The rows of cell c, and the words of candidate bits each of its particles
- * takes. */
-KERNEL int rows_of(const list_build *lb, size_t c, int dim, uint32_t *rows, size_t *nwords)
+/* The rows of cell c (as the plan pass stored them), and the words of
+ * candidate bits each of its particles takes. */
+KERNEL int rows_of(const list_build *lb, size_t c, const uint32_t **rows, size_t *nwords)
 {
-    cell_bounds cb;
-    bounds_of_cell(lb->g, c, lb->nrows, &cb);
-    int n = cell_rows(lb->g, &cb, c, &lb->t, lb->radius, lb->inv_width, dim, rows);
-    *nwords = words_per_particle(rows, n);
+    const uint32_t *r = lb->cell_ranges + c * lb->range_slots;
+    const int n = (int)r[0];
+    *rows = r + 1;
+    *nwords = words_per_particle(r + 1, n);
     return n;
 }
 
-/* Pass 0: cell_word[c + 1] = words of the particles of cell c. */
+/* Pass 0: the ranges of cell c, and cell_word[c + 1] = words of the
+ * particles of cell c. */
 KERNEL void plan_cell(const list_build *lb, size_t c, int dim)
 {
-    uint32_t rows[2 * MAX_ROWS];
-    size_t nw = 0;
-    rows_of(lb, c, dim, rows, &nw);
-    lb->cell_word[c + 1] = nw * (lb->g->cell_start[c + 1] - lb->g->cell_start[c]);
+    cell_bounds cb;
+    bounds_of_cell(lb->g, c, lb->nrows, &cb);
+    uint32_t *r = lb->cell_ranges + c * lb->range_slots;
+    const int n = cell_rows(lb->g, &cb, c, &lb->t, lb->radius, lb->inv_width, dim, r + 1);
+    r[0] = (uint32_t)n;
+    lb->cell_word[c + 1] =
+        words_per_particle(r + 1, n) * (lb->g->cell_start[c + 1] - lb->g->cell_start[c]);
 }
 
 /* Pass 1: start[i + 1] = number of neighbours of i; bits if kept; with sub
@@ -449,9 +458,9 @@ KERNEL void count_cell(const list_build *lb, size_t c, int dim, bool keep_bits, 
                        uint32_t *start, uint32_t *sstart)
 {
     const mf_grid *g = lb->g;
-    uint32_t rows[2 * MAX_ROWS];
+    const uint32_t *rows = NULL;
     size_t nw = 0;
-    const int n = rows_of(lb, c, dim, rows, &nw);
+    const int n = rows_of(lb, c, &rows, &nw);
     const size_t k0 = g->cell_start[c];
     for (size_t k = k0; k < g->cell_start[c + 1]; k++) {
         double xi[3];
@@ -473,9 +482,9 @@ KERNEL void fill_cell(const list_build *lb, size_t c, int dim, const uint32_t *s
                       uint32_t *jlist, const uint32_t *sstart, uint32_t *sjlist)
 {
     const mf_grid *g = lb->g;
-    uint32_t rows[2 * MAX_ROWS];
+    const uint32_t *rows = NULL;
     size_t nw = 0;
-    const int n = rows_of(lb, c, dim, rows, &nw);
+    const int n = rows_of(lb, c, &rows, &nw);
     size_t row_bit[MAX_ROWS + 1];
     row_bit_offsets(rows, n, row_bit);
     const size_t k0 = g->cell_start[c];
@@ -564,19 +573,26 @@ static void fill_pass(const list_build *lb, const uint32_t *start, uint32_t *jli
     }
 }
 
-/* Lay out the candidate bits: word offsets per cell at the start of the
- * scratch, the bits after them. Leaves lb->cell_word NULL (no bits) when
- * they would exceed MAX_BIT_WORDS_PER_PARTICLE on average. */
+/* Lay out the scratch: word offsets per cell at its start, the cells'
+ * ranges after them, then the candidate bits. Leaves lb->cell_word NULL (no
+ * bits) when they would exceed MAX_BIT_WORDS_PER_PARTICLE on average. */
 static int plan_bits(mf_nlist *nl, list_build *lb)
 {
     const size_t np = lb->g->np, ncells = lb->g->ncells;
     lb->cell_word = NULL;
     lb->bits = NULL;
+    lb->range_slots = 1 + 2 * (size_t)lb->nrows;
+    const size_t words_bytes = (ncells + 1) * sizeof(size_t);
+    const size_t ranges_bytes =
+        (ncells * lb->range_slots * sizeof(uint32_t) + sizeof(uint64_t) - 1) /
+        sizeof(uint64_t) * sizeof(uint64_t);
+    const size_t head = words_bytes + ranges_bytes;
     /* Grow only: the bits that follow the offsets need the space again. */
-    if (!nl->work || nl->work_bytes < (ncells + 1) * sizeof(size_t))
-        MF_CALL(ensure_work(nl, (ncells + 1) * sizeof(size_t)));
+    if (!nl->work || nl->work_bytes < head)
+        MF_CALL(ensure_work(nl, head));
     size_t *cell_word = nl->work;
     lb->cell_word = cell_word;
+    lb->cell_ranges = (uint32_t *)((char *)nl->work + words_bytes);
     plan_pass(lb);
     cell_word[0] = 0;
     for (size_t c = 0; c < ncells; c++)
@@ -586,8 +602,8 @@ static int plan_bits(mf_nlist *nl, list_build *lb)
         lb->cell_word = NULL;
         return 0;
     }
-    const size_t need = (ncells + 1) * sizeof(size_t) + total * sizeof(uint64_t);
-    if (nl->work_bytes < need) { /* grow, keeping the offsets just planned */
+    const size_t need = head + total * sizeof(uint64_t);
+    if (nl->work_bytes < need) { /* grow, keeping the offsets and ranges just planned */
         size_t cap = with_headroom(need);
         if (mf_resize(&nl->work, cap, 1))
             return MF_ERROR(MF_ERR_MEMORY, "cannot allocate neighbour list scratch (%zu bytes)",
@@ -595,8 +611,9 @@ static int plan_bits(mf_nlist *nl, list_build *lb)
         nl->work_bytes = cap;
         cell_word = nl->work;
         lb->cell_word = cell_word;
+        lb->cell_ranges = (uint32_t *)((char *)nl->work + words_bytes);
     }
-    lb->bits = (uint64_t *)(cell_word + ncells + 1);
+    lb->bits = (uint64_t *)((char *)nl->work + head);
     return 0;
 }
 
