@@ -68,7 +68,12 @@ static inline bool min_pair(void *acc, const void *ctx, const mf_pair *pr)
  * (a literal at the call sites: each compiles to its own loop). */
 enum { COEF_ONE, COEF_CONSTANT, COEF_RHO };
 
-static inline bool grad_pair(void *acc, const void *ctx, const mf_pair *pr, int mode)
+/* shape: the weight's (mf_grad_weight), or SHAPE_OF_CTX for c->weight's
+ * (a literal: the paper's weight compiles to a loop without the test). */
+#define SHAPE_OF_CTX (-1)
+
+static inline bool grad_pair_as(void *acc, const void *ctx, const mf_pair *pr, int mode,
+                                int shape)
 {
     const grad_ctx *c = ctx;
     const mf_gradient_opts *o = c->o;
@@ -79,18 +84,29 @@ static inline bool grad_pair(void *acc, const void *ctx, const mf_pair *pr, int 
                                                           o->rho_average)
                        : mode == COEF_CONSTANT ? o->coef
                                                : 1.0;
-    const double s =
-        mf_gradient_term(o->f[pr->j] - a->fhat, cij,
-                         mf_weight_gradient(pr->len, c->v->radius, c->weight), pr->len);
+    const double s = mf_gradient_term(
+        o->f[pr->j] - a->fhat, cij,
+        mf_weight_gradient(pr->len, c->v->radius, shape == SHAPE_OF_CTX ? c->weight : shape),
+        pr->len);
     a->g[0] += s * pr->r[0];
     a->g[1] += s * pr->r[1];
     a->g[2] += s * pr->r[2];
     return true;
 }
 
+static inline bool grad_pair(void *acc, const void *ctx, const mf_pair *pr, int mode)
+{
+    return grad_pair_as(acc, ctx, pr, mode, SHAPE_OF_CTX);
+}
+
 static inline bool grad_pair_one(void *acc, const void *ctx, const mf_pair *pr)
 {
     return grad_pair(acc, ctx, pr, COEF_ONE);
+}
+
+static inline bool grad_pair_one_paper(void *acc, const void *ctx, const mf_pair *pr)
+{
+    return grad_pair_as(acc, ctx, pr, COEF_ONE, MF_GRAD_WEIGHT_PAPER);
 }
 
 static inline bool grad_pair_constant(void *acc, const void *ctx, const mf_pair *pr)
@@ -161,7 +177,9 @@ static void cgrad_row_one(const void *ctx, size_t i) { cgrad_row(ctx, i, COEF_ON
 static void cgrad_row_constant(const void *ctx, size_t i) { cgrad_row(ctx, i, COEF_CONSTANT); }
 static void cgrad_row_rho(const void *ctx, size_t i) { cgrad_row(ctx, i, COEF_RHO); }
 
-static inline void grad_row(const void *ctx, size_t i, int mode)
+/* mode: COEF_*; paper: the paper's weight (with COEF_ONE only). */
+static inline __attribute__((always_inline)) void grad_row_as(const void *ctx, size_t i,
+                                                              int mode, bool paper)
 {
     const grad_ctx *c = ctx;
     const mf_gradient_opts *o = c->o;
@@ -172,6 +190,8 @@ static inline void grad_row(const void *ctx, size_t i, int mode)
         mf_pairs_row(c->v, i, c->jmask, grad_pair_rho, c, &a);
     else if (mode == COEF_CONSTANT)
         mf_pairs_row(c->v, i, c->jmask, grad_pair_constant, c, &a);
+    else if (paper)
+        mf_pairs_row(c->v, i, c->jmask, grad_pair_one_paper, c, &a);
     else
         mf_pairs_row(c->v, i, c->jmask, grad_pair_one, c, &a);
     c->out[3 * i + 0] = c->coef * a.g[0];
@@ -179,7 +199,13 @@ static inline void grad_row(const void *ctx, size_t i, int mode)
     c->out[3 * i + 2] = c->coef * a.g[2];
 }
 
+static inline void grad_row(const void *ctx, size_t i, int mode)
+{
+    grad_row_as(ctx, i, mode, false);
+}
+
 static void grad_row_one(const void *ctx, size_t i) { grad_row(ctx, i, COEF_ONE); }
+static void grad_row_one_paper(const void *ctx, size_t i) { grad_row_as(ctx, i, COEF_ONE, true); }
 static void grad_row_constant(const void *ctx, size_t i) { grad_row(ctx, i, COEF_CONSTANT); }
 static void grad_row_rho(const void *ctx, size_t i) { grad_row(ctx, i, COEF_RHO); }
 
@@ -196,6 +222,8 @@ void mf_gradient_ex(const mf_pairs *v, const mf_kernel *k, const mf_gradient_opt
             mf_pairs_each(v, imask, cgrad_row_constant, &c);
     } else if (o->rho)
         mf_pairs_each(v, imask, grad_row_rho, &c);
+    else if (o->coef == 1.0 && c.weight == MF_GRAD_WEIGHT_PAPER)
+        mf_pairs_each(v, imask, grad_row_one_paper, &c);
     else if (o->coef == 1.0)
         mf_pairs_each(v, imask, grad_row_one, &c);
     else
