@@ -30,11 +30,20 @@ static void nd_row(const void *ctx, size_t i)
     c->out[i] = sum;
 }
 
+/* The same with every neighbour (jmask NULL, a literal: no test a pair). */
+static void nd_row_all(const void *ctx, size_t i)
+{
+    const nd_ctx *c = ctx;
+    double sum = 0.0;
+    mf_pairs_row(c->v, i, NULL, nd_pair, c, &sum);
+    c->out[i] = sum;
+}
+
 void mf_number_density(const mf_pairs *v, const uint8_t *imask, const uint8_t *jmask,
                        double *n)
 {
     const nd_ctx c = {v, jmask, n};
-    mf_pairs_each(v, imask, nd_row, &c);
+    mf_pairs_each(v, imask, jmask ? nd_row : nd_row_all, &c);
 }
 
 /* ---- gradient ------------------------------------------------------------ */
@@ -359,15 +368,27 @@ static void lap3_row(const void *ctx, size_t i)
         c->out[3 * i + q] = c->coef * a[q];
 }
 
-static void lap3_add_row(const void *ctx, size_t i)
+static inline __attribute__((always_inline)) void lap3_add_row_as(const void *ctx, size_t i,
+                                                                  const uint8_t *jmask)
 {
     const lap_ctx *c = ctx;
     double a[3] = {0.0, 0.0, 0.0};
-    mf_pairs_row(c->v, i, c->jmask, lap3_pair, c, a);
+    mf_pairs_row(c->v, i, jmask, lap3_pair, c, a);
     for (int q = 0; q < 3; q++) {
         const double lap = c->coef * a[q];
         c->out[3 * i + q] += c->scale * lap;
     }
+}
+
+static void lap3_add_row(const void *ctx, size_t i)
+{
+    lap3_add_row_as(ctx, i, ((const lap_ctx *)ctx)->jmask);
+}
+
+/* The same with every neighbour (jmask NULL, a literal: no test a pair). */
+static void lap3_add_row_all(const void *ctx, size_t i)
+{
+    lap3_add_row_as(ctx, i, NULL);
 }
 
 static void lap3_mu_row(const void *ctx, size_t i)
@@ -480,7 +501,7 @@ void mf_laplacian_add(const mf_pairs *v, const mf_kernel *k, const double *f, do
 {
     const lap_ctx c = {.v = v, .jmask = jmask, .f = f, .ncomp = 3, .coef = lap_coef(k),
                        .scale = scale, .out = out};
-    mf_pairs_each(v, imask, lap3_add_row, &c);
+    mf_pairs_each(v, imask, jmask ? lap3_add_row : lap3_add_row_all, &c);
 }
 
 /* The number density and, in the same pass over each row, the viscous
