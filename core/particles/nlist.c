@@ -257,13 +257,17 @@ KERNEL size_t test_candidates(const pair_test *t, const uint32_t *rows, int nrow
     return (size_t)(hits[0] + hits[1]);
 }
 
-/* Append the particle indices of the set bits (other than k itself); with
- * sub (a literal), those closer than the sub-list's radius to sout too. */
-KERNEL size_t decode_bits(const uint64_t *words, size_t nwords, const uint32_t *rows,
-                          const size_t row_bit[MAX_ROWS + 1], const uint32_t *order, size_t k,
+/* Append the particle indices of the set bits but self_bit (the particle
+ * itself, cleared first: the bits are not read again); with sub (a
+ * literal), those closer than the sub-list's radius to sout too. Bit b of
+ * row r is candidate b + first[r] (first[r] = rows[2 r] - row_bit[r],
+ * modulo 2^64). */
+KERNEL size_t decode_bits(uint64_t *words, size_t nwords, const size_t row_bit[MAX_ROWS + 1],
+                          const size_t first[MAX_ROWS], size_t self_bit, const uint32_t *order,
                           uint32_t *out, bool sub, const pair_test *t, const double xi[3],
                           int dim, uint32_t *sout)
 {
+    words[self_bit / 64] &= ~(UINT64_C(1) << (self_bit % 64));
     size_t w = 0, ws = 0;
     int r = 0;
     for (size_t wi = 0; wi < nwords; wi++) {
@@ -273,12 +277,10 @@ KERNEL size_t decode_bits(const uint64_t *words, size_t nwords, const uint32_t *
             word &= word - 1;
             while (bit >= row_bit[r + 1])
                 r++;
-            size_t m = rows[2 * r] + (bit - row_bit[r]);
-            if (m != k) {
-                out[w++] = order[m];
-                if (sub && distance2_1(t, m, xi, dim) < t->r2s)
-                    sout[ws++] = order[m];
-            }
+            const size_t m = bit + first[r];
+            out[w++] = order[m];
+            if (sub && distance2_1(t, m, xi, dim) < t->r2s)
+                sout[ws++] = order[m];
         }
     }
     return w;
@@ -485,22 +487,30 @@ KERNEL void fill_cell(const list_build *lb, size_t c, int dim, const uint32_t *s
     const uint32_t *rows = NULL;
     size_t nw = 0;
     const int n = rows_of(lb, c, &rows, &nw);
-    size_t row_bit[MAX_ROWS + 1];
+    size_t row_bit[MAX_ROWS + 1], first[MAX_ROWS];
     row_bit_offsets(rows, n, row_bit);
     const size_t k0 = g->cell_start[c];
+    /* The cell's own row: its particles are candidates there, k at bit
+     * own_bit + k. */
+    size_t own_bit = 0;
+    for (int r = 0; r < n; r++) {
+        first[r] = (size_t)rows[2 * r] - row_bit[r];
+        if (rows[2 * r] <= k0 && k0 < rows[2 * r + 1])
+            own_bit = row_bit[r] - (size_t)rows[2 * r];
+    }
     for (size_t k = k0; k < g->cell_start[c + 1]; k++) {
         double xi[3];
         load_position(&lb->t, k, xi);
         const uint32_t i = g->order[k];
         uint32_t *out = jlist + start[i];
         if (lb->cell_word) {
-            const uint64_t *words = lb->bits + lb->cell_word[c] + (k - k0) * nw;
+            uint64_t *words = lb->bits + lb->cell_word[c] + (k - k0) * nw;
             if (sstart)
-                decode_bits(words, nw, rows, row_bit, g->order, k, out, true, &lb->t, xi, dim,
-                            sjlist + sstart[i]);
+                decode_bits(words, nw, row_bit, first, own_bit + k, g->order, out, true, &lb->t,
+                            xi, dim, sjlist + sstart[i]);
             else
-                decode_bits(words, nw, rows, row_bit, g->order, k, out, false, &lb->t, xi, dim,
-                            NULL);
+                decode_bits(words, nw, row_bit, first, own_bit + k, g->order, out, false,
+                            &lb->t, xi, dim, NULL);
         } else {
             retest_candidates(&lb->t, rows, n, g->order, k, xi, dim, lb->t.r2, out);
             if (sstart)
