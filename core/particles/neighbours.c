@@ -234,19 +234,31 @@ static double displacement(const nb_class *c, const mf_particles *p)
     const double *sx = c->grid.spos, *sy = sx + np, *sz = sx + 2 * np;
     const double *pos = p->pos;
     const int64_t *id = p->id, *id0 = c->id0;
-    const bool three = p->dim == 3;
     size_t moved_slots = 0;
     double d2max = 0;
+    if (p->dim == 3) {
 #pragma omp parallel for schedule(dynamic, MF_STREAM_CHUNK) \
     reduction(+ : moved_slots) reduction(max : d2max)
-    for (size_t k = 0; k < np; k++) {
-        const size_t i = order[k];
-        moved_slots += id[i] != id0[k];
-        const double dx = pos[3 * i] - sx[k], dy = pos[3 * i + 1] - sy[k];
-        const double dz = three ? pos[3 * i + 2] - sz[k] : 0.0;
-        const double d2 = dx * dx + dy * dy + dz * dz;
-        if (!(d2 <= d2max)) /* NaN: the build that follows reports it */
-            d2max = isnan(d2) ? INFINITY : d2;
+        for (size_t k = 0; k < np; k++) {
+            const size_t i = order[k];
+            moved_slots += id[i] != id0[k];
+            const double dx = pos[3 * i] - sx[k], dy = pos[3 * i + 1] - sy[k];
+            const double dz = pos[3 * i + 2] - sz[k];
+            const double d2 = dx * dx + dy * dy + dz * dz;
+            if (!(d2 <= d2max)) /* NaN: the build that follows reports it */
+                d2max = isnan(d2) ? INFINITY : d2;
+        }
+    } else { /* 2-D: no z (a loop of its own, not a test a particle) */
+#pragma omp parallel for schedule(dynamic, MF_STREAM_CHUNK) \
+    reduction(+ : moved_slots) reduction(max : d2max)
+        for (size_t k = 0; k < np; k++) {
+            const size_t i = order[k];
+            moved_slots += id[i] != id0[k];
+            const double dx = pos[3 * i] - sx[k], dy = pos[3 * i + 1] - sy[k];
+            const double d2 = dx * dx + dy * dy;
+            if (!(d2 <= d2max))
+                d2max = isnan(d2) ? INFINITY : d2;
+        }
     }
     return moved_slots ? NAN : sqrt(d2max);
 }
