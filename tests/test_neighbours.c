@@ -513,6 +513,93 @@ static void test_determinism(void)
     mf_particles_destroy(p);
 }
 
+/* A copy of a list (start and entries). */
+static void copy_list(mf_nlist *to, const mf_nlist *from)
+{
+    mf_nlist_init(to);
+    to->n = from->n;
+    to->radius = from->radius;
+    to->start = malloc((from->n + 1) * sizeof(uint32_t));
+    to->j = malloc((from->start[from->n] + 1) * sizeof(uint32_t));
+    memcpy(to->start, from->start, (from->n + 1) * sizeof(uint32_t));
+    memcpy(to->j, from->j, from->start[from->n] * sizeof(uint32_t));
+    to->cap_n = from->n + 1;
+    to->cap_j = from->start[from->n] + 1;
+}
+
+static bool same_lists(const mf_nlist *a, const mf_nlist *b)
+{
+    return a->n == b->n && memcmp(a->start, b->start, (a->n + 1) * sizeof(uint32_t)) == 0 &&
+           memcmp(a->j, b->j, a->start[a->n] * sizeof(uint32_t)) == 0;
+}
+
+/* A kept list re-sorted only where a particle changed cell (the service's
+ * way: mf_grid_cells at the build, mf_nlist_mark_moved, mf_nlist_sort_marked)
+ * is the list sorted in full, after random moves that take some particles
+ * into other cells, over three rounds (the cells of a round from its keys),
+ * for the list and the sub-list of the same build, in 2-D and 3-D. */
+static void test_sort_moved(void)
+{
+    for (int dim = 2; dim <= 3; dim++) {
+        mf_particles *p = random_points(dim, dim == 2 ? 3000 : 4000, 2.0);
+        const double cell = dim == 2 ? 0.1 : 0.25;
+        mf_grid g;
+        mf_nlist nl, sub;
+        mf_grid_init(&g);
+        mf_nlist_init(&nl);
+        mf_nlist_init(&sub);
+        CHECK_OK(mf_grid_build(&g, p, cell));
+        CHECK_OK(mf_nlist_build_pair(&nl, &sub, &g, p, cell, 0.6 * cell));
+        uint32_t *cell0 = malloc(p->n * sizeof *cell0);
+        uint64_t *keys = malloc(p->n * sizeof *keys);
+        uint8_t *dirty = malloc(p->n);
+        CHECK(mf_grid_cells(&g, cell0));
+        int reordered = 0;
+        for (int round = 0; round < 3; round++) {
+            for (size_t i = 0; i < p->n; i++)
+                for (int d = 0; d < dim; d++)
+                    p->pos[3 * i + d] += 0.1 * cell * (uniform() - 0.5);
+            bool packed = false;
+            CHECK_OK(mf_grid_keys(p, cell, keys, &packed));
+            CHECK(packed);
+            size_t moved = 0, marked = 0;
+            for (size_t i = 0; i < p->n; i++)
+                moved += (uint32_t)(keys[i] >> 32) != cell0[i];
+            mf_nlist full, fsub, orig;
+            copy_list(&orig, &nl);
+            copy_list(&full, &nl);
+            copy_list(&fsub, &sub);
+            mf_nlist_sort(&full, keys, packed);
+            mf_nlist_sort(&fsub, keys, packed);
+            mf_nlist_mark_moved(&nl, keys, cell0, dirty);
+            for (size_t i = 0; i < p->n; i++)
+                marked += dirty[i];
+            mf_nlist_sort_marked(&nl, keys, packed, dirty);
+            mf_nlist_sort_marked(&sub, keys, packed, dirty);
+            /* some particles crossed, and not every list was marked */
+            CHECK_MSG(moved > 0 && marked < p->n, "%d-D round %d: %zu moved, %zu of %zu marked",
+                      dim, round, moved, marked, p->n);
+            CHECK_MSG(same_lists(&nl, &full) && same_lists(&sub, &fsub),
+                      "%d-D round %d: the marked sort differs from the full sort", dim, round);
+            reordered += !same_lists(&orig, &full); /* the sorts had work to do */
+            mf_nlist_free(&orig);
+            for (size_t i = 0; i < p->n; i++)
+                cell0[i] = (uint32_t)(keys[i] >> 32);
+            mf_nlist_free(&full);
+            mf_nlist_free(&fsub);
+        }
+        CHECK_MSG(reordered == 3, "%d-D: the moves reordered the lists in %d of 3 rounds", dim,
+                  reordered);
+        free(cell0);
+        free(keys);
+        free(dirty);
+        mf_nlist_free(&nl);
+        mf_nlist_free(&sub);
+        mf_grid_free(&g);
+        mf_particles_destroy(p);
+    }
+}
+
 /* Sorting particles by cell (locality order) keeps every particle and its
  * fields; the lists of the sorted store are still right. */
 static void test_locality_order(void)
@@ -591,6 +678,7 @@ int main(void)
     test_rebuild();
     test_determinism();
     test_locality_order();
+    test_sort_moved();
     test_errors();
     return mf_test_summary("neighbours");
 }

@@ -1102,6 +1102,16 @@ static void test_bad_input(void)
         CHECK(strstr(mf_error_message(), "outside") != NULL);
     mf_error_clear();
     p.A.col[0] = saved;
+    /* A negative one, at the last entry (the range check's tail). */
+    const size_t last = p.A.rowptr[p.A.nrows] - 1;
+    saved = p.A.col[last];
+    if (rank == 0)
+        p.A.col[last] = -1;
+    CHECK(solve_once(&mf_pressure_PCG_BoomerAMG, &as, &p, &rep) == MF_ERR_INPUT);
+    if (rank == 0)
+        CHECK(strstr(mf_error_message(), "outside") != NULL);
+    mf_error_clear();
+    p.A.col[last] = saved;
 
     /* More rows than a 32-bit HYPRE_BigInt holds. */
     if (sizeof(HYPRE_BigInt) == 4 && nprocs == 1) {

@@ -402,6 +402,26 @@ int mf_grid_keys(const mf_particles *p, double cell_size, uint64_t *keys, bool *
     return 0;
 }
 
+bool mf_grid_cells(const mf_grid *g, uint32_t *cell)
+{
+    /* make_frame's key bits of the build (nbox is the frame's) */
+    int bits[3] = {0, 0, 0};
+    for (int d = 0; d < g->dim && g->np > 0; d++)
+        bits[d] = bits_for(g->nbox[d]);
+    if (bits[0] + bits[1] + bits[2] > 32)
+        return false;
+    const int sy = bits[0], sz = bits[0] + bits[1];
+    for (size_t c = 0; c < g->ncells; c++) {
+        const uint64_t key = g->cell_key[c];
+        const uint32_t compact = (uint32_t)((key & AXIS_MASK) |
+                                            ((key >> MF_GRID_AXIS_BITS) & AXIS_MASK) << sy |
+                                            (key >> (2 * MF_GRID_AXIS_BITS)) << sz);
+        for (uint32_t k = g->cell_start[c]; k < g->cell_start[c + 1]; k++)
+            cell[g->order[k]] = compact;
+    }
+    return true;
+}
+
 int mf_grid_build(mf_grid *g, const mf_particles *p, double cell_size)
 {
     return mf_grid_build_reach(g, p, cell_size, 1);

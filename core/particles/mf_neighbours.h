@@ -104,6 +104,10 @@ long mf_grid_point_cell(const mf_grid *g, const double x[3]);
  * *packed the index too (keys[i] < keys[j] exactly when (cell, i) comes
  * before (cell, j)). Fails as mf_grid_build does on a non-finite position. */
 int mf_grid_keys(const mf_particles *p, double cell_size, uint64_t *keys, bool *packed);
+/* cell[i] for i in [0, g->np): the cell of particle i in the grid, as the
+ * high 32 bits of the packed keys mf_grid_keys gave at the build's
+ * positions. Returns false (cell untouched) when those keys are not packed. */
+bool mf_grid_cells(const mf_grid *g, uint32_t *cell);
 
 void mf_nlist_init(mf_nlist *nl);
 void mf_nlist_free(mf_nlist *nl);
@@ -123,6 +127,20 @@ int mf_nlist_filter(mf_nlist *nl, const mf_nlist *from, const mf_particles *p, d
  * mf_grid_keys): the order a fresh build at the positions of the keys
  * gives. Cheap when the list is nearly in order already (insertion sort). */
 void mf_nlist_sort(mf_nlist *nl, const uint64_t *keys, bool packed);
+/* mf_nlist_sort in two steps for packed keys (mf_grid_keys: the cell in
+ * the high 32 bits, the index in the low) and a list in the order of the
+ * cells cell_before (built or sorted at them: mf_grid_cells) that is
+ * symmetric (j in i's list exactly when i is in j's: every list
+ * mf_nlist_build makes). mark sets dirty[i] (nl->n bytes) for each list
+ * that holds a particle whose cell changed, the lists of its neighbours;
+ * sort_marked sorts the marked lists only, which gives mf_nlist_sort's
+ * result (the unmarked ones are in order already). A sub-list made in the
+ * same build (mf_nlist_build_pair) holds a subset of each list: the
+ * list's marks serve it. */
+void mf_nlist_mark_moved(const mf_nlist *nl, const uint64_t *keys, const uint32_t *cell_before,
+                         uint8_t *dirty);
+void mf_nlist_sort_marked(mf_nlist *nl, const uint64_t *keys, bool packed,
+                          const uint8_t *dirty);
 size_t mf_nlist_memory(const mf_nlist *nl);
 /* Free the build's scratch (the candidate bits); the list stays usable. */
 void mf_nlist_release_scratch(mf_nlist *nl);

@@ -65,7 +65,14 @@ typedef struct nb_class {
     double sub_list_radius; /* sub_radius + the skin of the build */
     bool sub_wanted;    /* a request the sub-list would have served came during this life */
     bool built_once;
+    /* The cells the lists are in the order of (for re-sorting only the lists
+     * that hold a particle that changed cell): */
+    int cells_known;    /* CELLS_OF_BUILD, CELLS_KEPT (in cell0) or CELLS_UNKNOWN */
+    uint32_t *cell0;    /* CELLS_KEPT: each particle's cell, the high half of its packed key */
+    size_t cap_cell0;
 } nb_class;
+
+enum { CELLS_OF_BUILD = 0, CELLS_KEPT = 1, CELLS_UNKNOWN = 2 };
 
 typedef struct nb_handle {
     double radius, cell; /* cell 0: shared, resolved at the first use */
@@ -114,6 +121,7 @@ void mf_neighbours_destroy(mf_neighbours *nb)
         mf_nlist_free(&nb->cls[c].list);
         mf_nlist_free(&nb->cls[c].sub);
         free(nb->cls[c].id0);
+        free(nb->cls[c].cell0);
     }
     mf_grid_free(&nb->points);
     free(nb->cls);
@@ -226,19 +234,31 @@ static double displacement(const nb_class *c, const mf_particles *p)
     const double *sx = c->grid.spos, *sy = sx + np, *sz = sx + 2 * np;
     const double *pos = p->pos;
     const int64_t *id = p->id, *id0 = c->id0;
-    const bool three = p->dim == 3;
     size_t moved_slots = 0;
     double d2max = 0;
+    if (p->dim == 3) {
 #pragma omp parallel for schedule(dynamic, MF_STREAM_CHUNK) \
     reduction(+ : moved_slots) reduction(max : d2max)
-    for (size_t k = 0; k < np; k++) {
-        const size_t i = order[k];
-        moved_slots += id[i] != id0[k];
-        const double dx = pos[3 * i] - sx[k], dy = pos[3 * i + 1] - sy[k];
-        const double dz = three ? pos[3 * i + 2] - sz[k] : 0.0;
-        const double d2 = dx * dx + dy * dy + dz * dz;
-        if (!(d2 <= d2max)) /* NaN: the build that follows reports it */
-            d2max = isnan(d2) ? INFINITY : d2;
+        for (size_t k = 0; k < np; k++) {
+            const size_t i = order[k];
+            moved_slots += id[i] != id0[k];
+            const double dx = pos[3 * i] - sx[k], dy = pos[3 * i + 1] - sy[k];
+            const double dz = pos[3 * i + 2] - sz[k];
+            const double d2 = dx * dx + dy * dy + dz * dz;
+            if (!(d2 <= d2max)) /* NaN: the build that follows reports it */
+                d2max = isnan(d2) ? INFINITY : d2;
+        }
+    } else { /* 2-D: no z (a loop of its own, not a test a particle) */
+#pragma omp parallel for schedule(dynamic, MF_STREAM_CHUNK) \
+    reduction(+ : moved_slots) reduction(max : d2max)
+        for (size_t k = 0; k < np; k++) {
+            const size_t i = order[k];
+            moved_slots += id[i] != id0[k];
+            const double dx = pos[3 * i] - sx[k], dy = pos[3 * i + 1] - sy[k];
+            const double d2 = dx * dx + dy * dy;
+            if (!(d2 <= d2max))
+                d2max = isnan(d2) ? INFINITY : d2;
+        }
     }
     return moved_slots ? NAN : sqrt(d2max);
 }
@@ -278,11 +298,56 @@ static int build(mf_neighbours *nb, nb_class *c, const mf_particles *p)
     for (size_t k = 0; k < np; k++)
         c->id0[k] = p->id[c->grid.order[k]];
     c->store = p;
+    c->cells_known = CELLS_OF_BUILD;
     c->list_radius = R;
     c->d_first = -1;
     c->epoch = nb->epoch;
     nb->stats.builds++;
     nb->stats.entries = np ? (double)c->list.start[np] / (double)np : 0.0;
+    return 0;
+}
+
+/* The lists of class c into the order of keys (mf_grid_keys at the current
+ * positions). With packed keys and the cells of the lists' order known,
+ * only the lists that hold a particle that changed cell since are sorted
+ * (mf_nlist_mark_moved; the others are in that order already), else all:
+ * the same lists either way. */
+static int order_lists(nb_class *c, const uint64_t *keys, bool packed)
+{
+    const size_t n = c->list.n;
+    if (!packed) {
+        mf_nlist_sort(&c->list, keys, false);
+        if (c->sub_radius > 0)
+            mf_nlist_sort(&c->sub, keys, false);
+        c->cells_known = CELLS_UNKNOWN;
+        return 0;
+    }
+    if (n > c->cap_cell0) {
+        size_t cap = n + n / 8 + 16;
+        c->cells_known = c->cells_known == CELLS_KEPT ? CELLS_UNKNOWN : c->cells_known;
+        if (mf_resize(&c->cell0, cap, sizeof *c->cell0))
+            return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu particles' cells", n);
+        c->cap_cell0 = cap;
+    }
+    if (c->cells_known == CELLS_OF_BUILD)
+        c->cells_known = mf_grid_cells(&c->grid, c->cell0) ? CELLS_KEPT : CELLS_UNKNOWN;
+    uint8_t *dirty = c->cells_known == CELLS_KEPT ? malloc(n ? n : 1) : NULL;
+    if (c->cells_known == CELLS_KEPT && !dirty)
+        return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu list marks", n);
+    if (dirty) {
+        mf_nlist_mark_moved(&c->list, keys, c->cell0, dirty);
+        mf_nlist_sort_marked(&c->list, keys, true, dirty);
+        if (c->sub_radius > 0)
+            mf_nlist_sort_marked(&c->sub, keys, true, dirty);
+        free(dirty);
+    } else {
+        mf_nlist_sort(&c->list, keys, true);
+        if (c->sub_radius > 0)
+            mf_nlist_sort(&c->sub, keys, true);
+    }
+    for (size_t i = 0; i < n; i++)
+        c->cell0[i] = (uint32_t)(keys[i] >> 32);
+    c->cells_known = CELLS_KEPT;
     return 0;
 }
 
@@ -306,10 +371,9 @@ static int refresh(mf_neighbours *nb, nb_class *c, const mf_particles *p, double
             uint64_t *keys = malloc((p->n ? p->n : 1) * sizeof *keys);
             rc = keys ? mf_grid_keys(p, c->cell, keys, &packed)
                       : MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu sort keys", p->n);
+            if (rc == 0)
+                rc = order_lists(c, keys, packed);
             if (rc == 0) {
-                mf_nlist_sort(&c->list, keys, packed);
-                if (c->sub_radius > 0)
-                    mf_nlist_sort(&c->sub, keys, packed);
                 c->epoch = nb->epoch;
                 nb->stats.sorts++;
             }

@@ -257,13 +257,17 @@ KERNEL size_t test_candidates(const pair_test *t, const uint32_t *rows, int nrow
     return (size_t)(hits[0] + hits[1]);
 }
 
-/* Append the particle indices of the set bits (other than k itself); with
- * sub (a literal), those closer than the sub-list's radius to sout too. */
-KERNEL size_t decode_bits(const uint64_t *words, size_t nwords, const uint32_t *rows,
-                          const size_t row_bit[MAX_ROWS + 1], const uint32_t *order, size_t k,
+/* Append the particle indices of the set bits but self_bit (the particle
+ * itself, cleared first: the bits are not read again); with sub (a
+ * literal), those closer than the sub-list's radius to sout too. Bit b of
+ * row r is candidate b + first[r] (first[r] = rows[2 r] - row_bit[r],
+ * modulo 2^64). */
+KERNEL size_t decode_bits(uint64_t *words, size_t nwords, const size_t row_bit[MAX_ROWS + 1],
+                          const size_t first[MAX_ROWS], size_t self_bit, const uint32_t *order,
                           uint32_t *out, bool sub, const pair_test *t, const double xi[3],
                           int dim, uint32_t *sout)
 {
+    words[self_bit / 64] &= ~(UINT64_C(1) << (self_bit % 64));
     size_t w = 0, ws = 0;
     int r = 0;
     for (size_t wi = 0; wi < nwords; wi++) {
@@ -273,12 +277,10 @@ KERNEL size_t decode_bits(const uint64_t *words, size_t nwords, const uint32_t *
             word &= word - 1;
             while (bit >= row_bit[r + 1])
                 r++;
-            size_t m = rows[2 * r] + (bit - row_bit[r]);
-            if (m != k) {
-                out[w++] = order[m];
-                if (sub && distance2_1(t, m, xi, dim) < t->r2s)
-                    sout[ws++] = order[m];
-            }
+            const size_t m = bit + first[r];
+            out[w++] = order[m];
+            if (sub && distance2_1(t, m, xi, dim) < t->r2s)
+                sout[ws++] = order[m];
         }
     }
     return w;
@@ -414,6 +416,11 @@ typedef struct {
     int nrows;               /* rows stored per cell */
     size_t *cell_word;       /* ncells + 1 word offsets, or NULL: no bits */
     uint64_t *bits;
+    /* The candidate ranges of each cell, found once by the plan pass for the
+     * count and fill passes: at cell_ranges + c * range_slots, their number,
+     * then (begin, end) of each. */
+    uint32_t *cell_ranges;
+    size_t range_slots;
 } list_build;
 
 static inline void load_position(const pair_test *t, size_t k, double xi[3])
@@ -423,24 +430,28 @@ static inline void load_position(const pair_test *t, size_t k, double xi[3])
     xi[2] = t->sz[k];
 }
 
-/* The rows of cell c, and the words of candidate bits each of its particles
- * takes. */
-KERNEL int rows_of(const list_build *lb, size_t c, int dim, uint32_t *rows, size_t *nwords)
+/* The rows of cell c (as the plan pass stored them), and the words of
+ * candidate bits each of its particles takes. */
+KERNEL int rows_of(const list_build *lb, size_t c, const uint32_t **rows, size_t *nwords)
 {
-    cell_bounds cb;
-    bounds_of_cell(lb->g, c, lb->nrows, &cb);
-    int n = cell_rows(lb->g, &cb, c, &lb->t, lb->radius, lb->inv_width, dim, rows);
-    *nwords = words_per_particle(rows, n);
+    const uint32_t *r = lb->cell_ranges + c * lb->range_slots;
+    const int n = (int)r[0];
+    *rows = r + 1;
+    *nwords = words_per_particle(r + 1, n);
     return n;
 }
 
-/* Pass 0: cell_word[c + 1] = words of the particles of cell c. */
+/* Pass 0: the ranges of cell c, and cell_word[c + 1] = words of the
+ * particles of cell c. */
 KERNEL void plan_cell(const list_build *lb, size_t c, int dim)
 {
-    uint32_t rows[2 * MAX_ROWS];
-    size_t nw = 0;
-    rows_of(lb, c, dim, rows, &nw);
-    lb->cell_word[c + 1] = nw * (lb->g->cell_start[c + 1] - lb->g->cell_start[c]);
+    cell_bounds cb;
+    bounds_of_cell(lb->g, c, lb->nrows, &cb);
+    uint32_t *r = lb->cell_ranges + c * lb->range_slots;
+    const int n = cell_rows(lb->g, &cb, c, &lb->t, lb->radius, lb->inv_width, dim, r + 1);
+    r[0] = (uint32_t)n;
+    lb->cell_word[c + 1] =
+        words_per_particle(r + 1, n) * (lb->g->cell_start[c + 1] - lb->g->cell_start[c]);
 }
 
 /* Pass 1: start[i + 1] = number of neighbours of i; bits if kept; with sub
@@ -449,9 +460,9 @@ KERNEL void count_cell(const list_build *lb, size_t c, int dim, bool keep_bits, 
                        uint32_t *start, uint32_t *sstart)
 {
     const mf_grid *g = lb->g;
-    uint32_t rows[2 * MAX_ROWS];
+    const uint32_t *rows = NULL;
     size_t nw = 0;
-    const int n = rows_of(lb, c, dim, rows, &nw);
+    const int n = rows_of(lb, c, &rows, &nw);
     const size_t k0 = g->cell_start[c];
     for (size_t k = k0; k < g->cell_start[c + 1]; k++) {
         double xi[3];
@@ -473,25 +484,33 @@ KERNEL void fill_cell(const list_build *lb, size_t c, int dim, const uint32_t *s
                       uint32_t *jlist, const uint32_t *sstart, uint32_t *sjlist)
 {
     const mf_grid *g = lb->g;
-    uint32_t rows[2 * MAX_ROWS];
+    const uint32_t *rows = NULL;
     size_t nw = 0;
-    const int n = rows_of(lb, c, dim, rows, &nw);
-    size_t row_bit[MAX_ROWS + 1];
+    const int n = rows_of(lb, c, &rows, &nw);
+    size_t row_bit[MAX_ROWS + 1], first[MAX_ROWS];
     row_bit_offsets(rows, n, row_bit);
     const size_t k0 = g->cell_start[c];
+    /* The cell's own row: its particles are candidates there, k at bit
+     * own_bit + k. */
+    size_t own_bit = 0;
+    for (int r = 0; r < n; r++) {
+        first[r] = (size_t)rows[2 * r] - row_bit[r];
+        if (rows[2 * r] <= k0 && k0 < rows[2 * r + 1])
+            own_bit = row_bit[r] - (size_t)rows[2 * r];
+    }
     for (size_t k = k0; k < g->cell_start[c + 1]; k++) {
         double xi[3];
         load_position(&lb->t, k, xi);
         const uint32_t i = g->order[k];
         uint32_t *out = jlist + start[i];
         if (lb->cell_word) {
-            const uint64_t *words = lb->bits + lb->cell_word[c] + (k - k0) * nw;
+            uint64_t *words = lb->bits + lb->cell_word[c] + (k - k0) * nw;
             if (sstart)
-                decode_bits(words, nw, rows, row_bit, g->order, k, out, true, &lb->t, xi, dim,
-                            sjlist + sstart[i]);
+                decode_bits(words, nw, row_bit, first, own_bit + k, g->order, out, true, &lb->t,
+                            xi, dim, sjlist + sstart[i]);
             else
-                decode_bits(words, nw, rows, row_bit, g->order, k, out, false, &lb->t, xi, dim,
-                            NULL);
+                decode_bits(words, nw, row_bit, first, own_bit + k, g->order, out, false,
+                            &lb->t, xi, dim, NULL);
         } else {
             retest_candidates(&lb->t, rows, n, g->order, k, xi, dim, lb->t.r2, out);
             if (sstart)
@@ -564,19 +583,26 @@ static void fill_pass(const list_build *lb, const uint32_t *start, uint32_t *jli
     }
 }
 
-/* Lay out the candidate bits: word offsets per cell at the start of the
- * scratch, the bits after them. Leaves lb->cell_word NULL (no bits) when
- * they would exceed MAX_BIT_WORDS_PER_PARTICLE on average. */
+/* Lay out the scratch: word offsets per cell at its start, the cells'
+ * ranges after them, then the candidate bits. Leaves lb->cell_word NULL (no
+ * bits) when they would exceed MAX_BIT_WORDS_PER_PARTICLE on average. */
 static int plan_bits(mf_nlist *nl, list_build *lb)
 {
     const size_t np = lb->g->np, ncells = lb->g->ncells;
     lb->cell_word = NULL;
     lb->bits = NULL;
+    lb->range_slots = 1 + 2 * (size_t)lb->nrows;
+    const size_t words_bytes = (ncells + 1) * sizeof(size_t);
+    const size_t ranges_bytes =
+        (ncells * lb->range_slots * sizeof(uint32_t) + sizeof(uint64_t) - 1) /
+        sizeof(uint64_t) * sizeof(uint64_t);
+    const size_t head = words_bytes + ranges_bytes;
     /* Grow only: the bits that follow the offsets need the space again. */
-    if (!nl->work || nl->work_bytes < (ncells + 1) * sizeof(size_t))
-        MF_CALL(ensure_work(nl, (ncells + 1) * sizeof(size_t)));
+    if (!nl->work || nl->work_bytes < head)
+        MF_CALL(ensure_work(nl, head));
     size_t *cell_word = nl->work;
     lb->cell_word = cell_word;
+    lb->cell_ranges = (uint32_t *)((char *)nl->work + words_bytes);
     plan_pass(lb);
     cell_word[0] = 0;
     for (size_t c = 0; c < ncells; c++)
@@ -586,8 +612,8 @@ static int plan_bits(mf_nlist *nl, list_build *lb)
         lb->cell_word = NULL;
         return 0;
     }
-    const size_t need = (ncells + 1) * sizeof(size_t) + total * sizeof(uint64_t);
-    if (nl->work_bytes < need) { /* grow, keeping the offsets just planned */
+    const size_t need = head + total * sizeof(uint64_t);
+    if (nl->work_bytes < need) { /* grow, keeping the offsets and ranges just planned */
         size_t cap = with_headroom(need);
         if (mf_resize(&nl->work, cap, 1))
             return MF_ERROR(MF_ERR_MEMORY, "cannot allocate neighbour list scratch (%zu bytes)",
@@ -595,8 +621,9 @@ static int plan_bits(mf_nlist *nl, list_build *lb)
         nl->work_bytes = cap;
         cell_word = nl->work;
         lb->cell_word = cell_word;
+        lb->cell_ranges = (uint32_t *)((char *)nl->work + words_bytes);
     }
-    lb->bits = (uint64_t *)(cell_word + ncells + 1);
+    lb->bits = (uint64_t *)((char *)nl->work + head);
     return 0;
 }
 
@@ -697,6 +724,38 @@ void mf_nlist_sort(mf_nlist *nl, const uint64_t *keys, bool packed)
     uint32_t *jl = nl->j;
 #pragma omp parallel for schedule(dynamic, 256)
     for (long i = 0; i < n; i++) {
+        if (packed)
+            sort_one(jl + start[i], start[i + 1] - start[i], keys, true);
+        else
+            sort_one(jl + start[i], start[i + 1] - start[i], keys, false);
+    }
+}
+
+/* The lists that hold a particle whose cell changed: by symmetry, those of
+ * the moved particles' own neighbours. */
+void mf_nlist_mark_moved(const mf_nlist *nl, const uint64_t *keys, const uint32_t *cell_before,
+                         uint8_t *dirty)
+{
+    const size_t n = nl->n;
+    const uint32_t *start = nl->start, *jl = nl->j;
+    memset(dirty, 0, n);
+    for (size_t j = 0; j < n; j++) /* serial: a few particles change cell a step */
+        if ((uint32_t)(keys[j] >> 32) != cell_before[j])
+            for (uint32_t e = start[j]; e < start[j + 1]; e++)
+                dirty[jl[e]] = 1;
+}
+
+/* Only a marked list can be out of order: the others hold only particles
+ * whose key is the one they were sorted by. */
+void mf_nlist_sort_marked(mf_nlist *nl, const uint64_t *keys, bool packed, const uint8_t *dirty)
+{
+    const long n = (long)nl->n;
+    const uint32_t *start = nl->start;
+    uint32_t *jl = nl->j;
+#pragma omp parallel for schedule(dynamic, 256)
+    for (long i = 0; i < n; i++) {
+        if (!dirty[i])
+            continue;
         if (packed)
             sort_one(jl + start[i], start[i + 1] - start[i], keys, true);
         else

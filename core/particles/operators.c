@@ -30,11 +30,20 @@ static void nd_row(const void *ctx, size_t i)
     c->out[i] = sum;
 }
 
+/* The same with every neighbour (jmask NULL, a literal: no test a pair). */
+static void nd_row_all(const void *ctx, size_t i)
+{
+    const nd_ctx *c = ctx;
+    double sum = 0.0;
+    mf_pairs_row(c->v, i, NULL, nd_pair, c, &sum);
+    c->out[i] = sum;
+}
+
 void mf_number_density(const mf_pairs *v, const uint8_t *imask, const uint8_t *jmask,
                        double *n)
 {
     const nd_ctx c = {v, jmask, n};
-    mf_pairs_each(v, imask, nd_row, &c);
+    mf_pairs_each(v, imask, jmask ? nd_row : nd_row_all, &c);
 }
 
 /* ---- gradient ------------------------------------------------------------ */
@@ -68,7 +77,12 @@ static inline bool min_pair(void *acc, const void *ctx, const mf_pair *pr)
  * (a literal at the call sites: each compiles to its own loop). */
 enum { COEF_ONE, COEF_CONSTANT, COEF_RHO };
 
-static inline bool grad_pair(void *acc, const void *ctx, const mf_pair *pr, int mode)
+/* shape: the weight's (mf_grad_weight), or SHAPE_OF_CTX for c->weight's
+ * (a literal: the paper's weight compiles to a loop without the test). */
+#define SHAPE_OF_CTX (-1)
+
+static inline bool grad_pair_as(void *acc, const void *ctx, const mf_pair *pr, int mode,
+                                int shape)
 {
     const grad_ctx *c = ctx;
     const mf_gradient_opts *o = c->o;
@@ -79,18 +93,29 @@ static inline bool grad_pair(void *acc, const void *ctx, const mf_pair *pr, int 
                                                           o->rho_average)
                        : mode == COEF_CONSTANT ? o->coef
                                                : 1.0;
-    const double s =
-        mf_gradient_term(o->f[pr->j] - a->fhat, cij,
-                         mf_weight_gradient(pr->len, c->v->radius, c->weight), pr->len);
+    const double s = mf_gradient_term(
+        o->f[pr->j] - a->fhat, cij,
+        mf_weight_gradient(pr->len, c->v->radius, shape == SHAPE_OF_CTX ? c->weight : shape),
+        pr->len);
     a->g[0] += s * pr->r[0];
     a->g[1] += s * pr->r[1];
     a->g[2] += s * pr->r[2];
     return true;
 }
 
+static inline bool grad_pair(void *acc, const void *ctx, const mf_pair *pr, int mode)
+{
+    return grad_pair_as(acc, ctx, pr, mode, SHAPE_OF_CTX);
+}
+
 static inline bool grad_pair_one(void *acc, const void *ctx, const mf_pair *pr)
 {
     return grad_pair(acc, ctx, pr, COEF_ONE);
+}
+
+static inline bool grad_pair_one_paper(void *acc, const void *ctx, const mf_pair *pr)
+{
+    return grad_pair_as(acc, ctx, pr, COEF_ONE, MF_GRAD_WEIGHT_PAPER);
 }
 
 static inline bool grad_pair_constant(void *acc, const void *ctx, const mf_pair *pr)
@@ -161,7 +186,9 @@ static void cgrad_row_one(const void *ctx, size_t i) { cgrad_row(ctx, i, COEF_ON
 static void cgrad_row_constant(const void *ctx, size_t i) { cgrad_row(ctx, i, COEF_CONSTANT); }
 static void cgrad_row_rho(const void *ctx, size_t i) { cgrad_row(ctx, i, COEF_RHO); }
 
-static inline void grad_row(const void *ctx, size_t i, int mode)
+/* mode: COEF_*; paper: the paper's weight (with COEF_ONE only). */
+static inline __attribute__((always_inline)) void grad_row_as(const void *ctx, size_t i,
+                                                              int mode, bool paper)
 {
     const grad_ctx *c = ctx;
     const mf_gradient_opts *o = c->o;
@@ -172,6 +199,8 @@ static inline void grad_row(const void *ctx, size_t i, int mode)
         mf_pairs_row(c->v, i, c->jmask, grad_pair_rho, c, &a);
     else if (mode == COEF_CONSTANT)
         mf_pairs_row(c->v, i, c->jmask, grad_pair_constant, c, &a);
+    else if (paper)
+        mf_pairs_row(c->v, i, c->jmask, grad_pair_one_paper, c, &a);
     else
         mf_pairs_row(c->v, i, c->jmask, grad_pair_one, c, &a);
     c->out[3 * i + 0] = c->coef * a.g[0];
@@ -179,7 +208,13 @@ static inline void grad_row(const void *ctx, size_t i, int mode)
     c->out[3 * i + 2] = c->coef * a.g[2];
 }
 
+static inline void grad_row(const void *ctx, size_t i, int mode)
+{
+    grad_row_as(ctx, i, mode, false);
+}
+
 static void grad_row_one(const void *ctx, size_t i) { grad_row(ctx, i, COEF_ONE); }
+static void grad_row_one_paper(const void *ctx, size_t i) { grad_row_as(ctx, i, COEF_ONE, true); }
 static void grad_row_constant(const void *ctx, size_t i) { grad_row(ctx, i, COEF_CONSTANT); }
 static void grad_row_rho(const void *ctx, size_t i) { grad_row(ctx, i, COEF_RHO); }
 
@@ -196,6 +231,8 @@ void mf_gradient_ex(const mf_pairs *v, const mf_kernel *k, const mf_gradient_opt
             mf_pairs_each(v, imask, cgrad_row_constant, &c);
     } else if (o->rho)
         mf_pairs_each(v, imask, grad_row_rho, &c);
+    else if (o->coef == 1.0 && c.weight == MF_GRAD_WEIGHT_PAPER)
+        mf_pairs_each(v, imask, grad_row_one_paper, &c);
     else if (o->coef == 1.0)
         mf_pairs_each(v, imask, grad_row_one, &c);
     else
@@ -265,9 +302,13 @@ typedef struct {
 
 /* c_ij (f_j - f_i) w for ncomp components (literals at the call sites, as
  * hl); c_ij = 1, or mu_ij with a pair viscosity; w the weight of eq. 3, or
- * with hl that of the higher-order Laplacian (mf_weight_hl). */
-static inline bool lap_pair_as(void *acc, const void *ctx, const mf_pair *pr, int ncomp, bool mu,
-                               bool hl)
+ * with hl that of the higher-order Laplacian (mf_weight_hl). Always
+ * inlined: with nine callers GCC kept one generic copy, called once a pair
+ * with ncomp, mu and hl tested at run time (a third of the viscous term's
+ * instructions on the bench 2-D case, docs/notes/speed.md). */
+static inline __attribute__((always_inline)) bool lap_pair_as(void *acc, const void *ctx,
+                                                              const mf_pair *pr, int ncomp,
+                                                              bool mu, bool hl)
 {
     const lap_ctx *c = ctx;
     double *a = acc;
@@ -327,15 +368,27 @@ static void lap3_row(const void *ctx, size_t i)
         c->out[3 * i + q] = c->coef * a[q];
 }
 
-static void lap3_add_row(const void *ctx, size_t i)
+static inline __attribute__((always_inline)) void lap3_add_row_as(const void *ctx, size_t i,
+                                                                  const uint8_t *jmask)
 {
     const lap_ctx *c = ctx;
     double a[3] = {0.0, 0.0, 0.0};
-    mf_pairs_row(c->v, i, c->jmask, lap3_pair, c, a);
+    mf_pairs_row(c->v, i, jmask, lap3_pair, c, a);
     for (int q = 0; q < 3; q++) {
         const double lap = c->coef * a[q];
         c->out[3 * i + q] += c->scale * lap;
     }
+}
+
+static void lap3_add_row(const void *ctx, size_t i)
+{
+    lap3_add_row_as(ctx, i, ((const lap_ctx *)ctx)->jmask);
+}
+
+/* The same with every neighbour (jmask NULL, a literal: no test a pair). */
+static void lap3_add_row_all(const void *ctx, size_t i)
+{
+    lap3_add_row_as(ctx, i, NULL);
 }
 
 static void lap3_mu_row(const void *ctx, size_t i)
@@ -448,7 +501,7 @@ void mf_laplacian_add(const mf_pairs *v, const mf_kernel *k, const double *f, do
 {
     const lap_ctx c = {.v = v, .jmask = jmask, .f = f, .ncomp = 3, .coef = lap_coef(k),
                        .scale = scale, .out = out};
-    mf_pairs_each(v, imask, lap3_add_row, &c);
+    mf_pairs_each(v, imask, jmask ? lap3_add_row : lap3_add_row_all, &c);
 }
 
 /* The number density and, in the same pass over each row, the viscous

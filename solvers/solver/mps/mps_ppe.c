@@ -175,14 +175,30 @@ typedef struct ppe_acc {
     bool touches;   /* a Dirichlet neighbour with w > 0 */
 } ppe_acc;
 
+/* hl: c->hl; rho: c->rho_p != NULL (literals at the call sites: the plain
+ * row, eq. 13's with one density, compiles to its own loop without their
+ * tests). */
+static inline __attribute__((always_inline)) double ppe_coef_as(const void *ctx,
+                                                                const mf_pair *pr, bool hl,
+                                                                bool rho)
+{
+    const ppe_ctx *c = ctx;
+    double cw = hl ? c->c * mf_weight_hl(pr->len, c->re, c->dim)
+                   : c->c * mf_weight(pr->len, c->re);
+    if (rho)
+        cw *= mf_inv_rho_pair(c->rho_p[pr->i], c->rho_p[pr->j], c->avg);
+    return cw;
+}
+
 static inline double ppe_coef(const void *ctx, const mf_pair *pr)
 {
     const ppe_ctx *c = ctx;
-    double cw = c->hl ? c->c * mf_weight_hl(pr->len, c->re, c->dim)
-                      : c->c * mf_weight(pr->len, c->re);
-    if (c->rho_p)
-        cw *= mf_inv_rho_pair(c->rho_p[pr->i], c->rho_p[pr->j], c->avg);
-    return cw;
+    return ppe_coef_as(ctx, pr, c->hl, c->rho_p != NULL);
+}
+
+static inline double ppe_coef_plain(const void *ctx, const mf_pair *pr)
+{
+    return ppe_coef_as(ctx, pr, false, false);
 }
 
 static inline void ppe_known(void *acc, const void *ctx, const mf_pair *pr, double a)
@@ -197,16 +213,21 @@ static inline void ppe_known(void *acc, const void *ctx, const mf_pair *pr, doub
 }
 
 /* The row's entries; 0: a fluid particle with no non-dummy neighbour
- * (reported by the caller). */
-static size_t ppe_row(const void *ctx, size_t i, size_t r)
+ * (reported by the caller). plain (a literal): no higher-order Laplacian,
+ * no density per particle. */
+static inline __attribute__((always_inline)) size_t ppe_row_as(const void *ctx, size_t i,
+                                                               size_t r, bool plain)
 {
     const ppe_ctx *c = ctx;
     mps_data *d = c->d;
     ppe_acc acc = {0.0, false};
     const size_t diag = c->rows.rowptr[r];
     size_t entries = 0;
-    const double sum = mf_pairs_row_assemble(&c->v, i, d->not_dummy, NULL, ppe_coef, ppe_known,
-                                             c, &acc, &c->rows, r, &entries);
+    const double sum =
+        plain ? mf_pairs_row_assemble(&c->v, i, d->not_dummy, NULL, ppe_coef_plain, ppe_known,
+                                      c, &acc, &c->rows, r, &entries)
+              : mf_pairs_row_assemble(&c->v, i, d->not_dummy, NULL, ppe_coef, ppe_known, c,
+                                      &acc, &c->rows, r, &entries);
     if (!(sum > 0) && d->is_fluid[i] && !d->wall)
         return 0; /* (wall weight: a particle with only the wall near takes p = 0 below) */
     const double dt2 = c->dt * c->dt;
@@ -236,6 +257,16 @@ static size_t ppe_row(const void *ctx, size_t i, size_t r)
         c->touches[r] = 1;
     d->x[r] = c->pressure[i]; /* warm start from the last step */
     return entries;
+}
+
+static size_t ppe_row(const void *ctx, size_t i, size_t r)
+{
+    return ppe_row_as(ctx, i, r, false);
+}
+
+static size_t ppe_row_plain(const void *ctx, size_t i, size_t r)
+{
+    return ppe_row_as(ctx, i, r, true);
 }
 
 /* Before the rows: room for the entries (a bound, mf_pairs_assemble). */
@@ -318,7 +349,8 @@ int mps_assemble_ppe(mps_data *d, const mf_sim *sim, double dt)
     c.re = c.v.radius;
     size_t failed = SIZE_MAX;
     if (rc == 0)
-        rc = mf_pairs_assemble(&c.v, &c.rows, nrows, ppe_sized, ppe_row, &c, &failed);
+        rc = mf_pairs_assemble(&c.v, &c.rows, nrows, ppe_sized,
+                               !c.hl && !c.rho_p ? ppe_row_plain : ppe_row, &c, &failed);
     if (rc == 0 && failed != SIZE_MAX) {
         /* n* counts dummy particles, the Laplacian does not: a fluid
          * particle with only dummies within re is inside a wall, and its
