@@ -102,6 +102,10 @@ static int request_neighbours(mps_data *d, mf_sim *sim)
     d->h_coll = -1;
     if (d->s.collision)
         MF_CALL(mf_neighbours_request(d->nb, dc < rmax ? dc : rmax, rmax, &d->h_coll));
+    const double dds = d->s.ds_distance * sim->l0;
+    d->h_ds = -1;
+    if (d->s.dynamic_stabilisation)
+        MF_CALL(mf_neighbours_request(d->nb, dds < rmax ? dds : rmax, rmax, &d->h_ds));
     return 0;
 }
 
