@@ -348,7 +348,10 @@ int mps_correction_phase(mps_data *d, mf_sim *sim, double dt)
         MF_CALL(mps_halo_sync(d, sim, d->work, sizeof *d->work));
         pr = d->work;
     }
-    mf_gradient(&v, &d->k_grad, pr, d->s.gradient_pmin, d->is_fluid, d->not_dummy, d->grad);
+    if (d->s.repulsion_radius > 0) /* eq. 5's repulsive part at its own radius */
+        MF_CALL(mps_gradient_split(d, sim, &v, pr));
+    else
+        mf_gradient(&v, &d->k_grad, pr, d->s.gradient_pmin, d->is_fluid, d->not_dummy, d->grad);
     MF_CALL(mps_bodies_pressure(d, sim, pr)); /* the rigid bodies' share, at r* */
     const double rho = sim->fluid[0].rho;
     if (d->wall) { /* the walls' part, with eq. 5's p^ of each particle */
