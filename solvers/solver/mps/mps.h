@@ -37,6 +37,7 @@ typedef struct mps_settings {
     bool wall_pressure_extrapolated; /* the gradient reads the walls' p from the fluid's (mps_wall_pressure.c) */
     bool dynamic_stabilisation; /* DS after the correction (Tsuruta et al. 2013, mps_ds.c) */
     double ds_distance;       /* DS: pairs closer than this, in l0 */
+    double velocity_filter;   /* XSPH eps after the correction (Monaghan 1989, mps_xsph.c; 0: off) */
     double repulsion_radius;  /* eq. 5's (p_i - p^_i) part at this radius, in l0 (0: eq. 5 as is) */
     /* The scheme (mps_scheme.c): a named set of the five choices below,
      * each of which a case may set apart ("scheme": the scheme's). */
@@ -182,7 +183,7 @@ typedef struct mps_data {
 enum { MPS_FLAG_SURFACE = 1 }; /* bits of the Flags field */
 
 extern const mf_solver_ops mf_solver_MPS;
-#define MPS_NPARAMS 33 /* checked against the table in mps_params.c */
+#define MPS_NPARAMS 34 /* checked against the table in mps_params.c */
 extern const mf_param mps_params[MPS_NPARAMS];
 extern const char *const mps_viscosity_choices[]; /* explicit, implicit */
 extern const char *const mps_wall_choices[];      /* particles, wallWeight */
@@ -239,6 +240,9 @@ extern const char *const mps_scheme_choices[], *const mps_source_choices[],
      "that takes them back to it in one step, shared by mass (Tsuruta, Khayyer & Gotoh 2013)"}, \
     {"dsDistance", MF_PARAM_SCALAR, "0.9", 0.1, 1.5, NULL, OFF(ds_distance),                   \
      "dynamicStabilisation: the pair distance it keeps, in l0"},                               \
+    {"velocityFilter", MF_PARAM_SCALAR, "0", 0, 1, NULL, OFF(velocity_filter),               \
+     "after the correction each fluid velocity moves by eps (1/n0) sum_j (u_j - u_i) w_ij "     \
+     "towards its fluid neighbours' (XSPH, Monaghan 1989, applied to the velocity; 0: off)"},  \
     {"repulsionRadius", MF_PARAM_SCALAR, "0", 0, 10, NULL, OFF(repulsion_radius),              \
      "gradient paper: eq. 5 split into its consistent part sum (p_j - p_i) at reGradient and " \
      "its repulsive part (p_i - p^_i) sum r w / r^2 at this radius, in l0 (0: eq. 5 as is)"},  \
@@ -372,6 +376,8 @@ int mps_bodies_pressure(mps_data *d, mf_sim *sim, const double *pressure);
 int mps_shift(mps_data *d, mf_sim *sim);
 /* mps_ds.c: dynamic stabilisation after the correction (Tsuruta et al. 2013). */
 int mps_dynamic_stabilisation(mps_data *d, mf_sim *sim, double dt);
+/* mps_xsph.c: the XSPH velocity filter after the correction (Monaghan 1989). */
+int mps_velocity_filter(mps_data *d, mf_sim *sim, double dt);
 /* mps_repulsion.c: eq. 5 with its repulsive part at repulsionRadius, into d->grad. */
 int mps_gradient_split(mps_data *d, mf_sim *sim, const mf_pairs *v, const double *pr);
 

@@ -333,6 +333,7 @@ int mps_correction_phase(mps_data *d, mf_sim *sim, double dt)
         if (!d->rho && d->s.collision && d->s.collision_after_correction)
             MF_CALL(collide(d, sim, dt));
         MF_CALL(mps_dynamic_stabilisation(d, sim, dt));
+    MF_CALL(mps_velocity_filter(d, sim, dt));
         d->t_correction += mf_wall_seconds() - t0;
         MF_CALL(mps_shift(d, sim));
         return 0;
@@ -375,6 +376,7 @@ int mps_correction_phase(mps_data *d, mf_sim *sim, double dt)
         MF_CALL(collide(d, sim, dt));
     }
     MF_CALL(mps_dynamic_stabilisation(d, sim, dt));
+    MF_CALL(mps_velocity_filter(d, sim, dt));
     d->t_correction += mf_wall_seconds() - t0;
     MF_CALL(mps_shift(d, sim));
     return 0;
