@@ -446,7 +446,7 @@ EXPECTED.update({
     'unknown top-level key':
         "--> mpsflow FATAL ERROR: {case}/system/solverDict:36:1: unknown key 'MSPCoeffs' in '(top level)' (did you mean 'MPSCoeffs'?); valid keys: solver, pressure, viscosity, forces, FoamFile, MPSCoeffs, multiFluidCoeffs, MAFLCoeffs",
     'unknown coefficient':
-        "--> mpsflow FATAL ERROR: {case}/system/solverDict:20:5: unknown key 'bta' in 'MPSCoeffs' (did you mean 'beta'?); valid keys: reNumberDensity, reGradient, reLaplacian, beta, relaxation, compressibility, clipNegativePressure, gradientPmin, gradientWeight, wallPressureExtrapolated, scheme, source, densityFactor, gradient, laplacian, shifting, shiftCoefficient, shiftMax, surfaceDetection, asymmetry, retrySource, collision, collisionAfterCorrection, collisionDistance, restitution, reorderInterval, viscosity, periodicLength, periodicOrigin, wall",
+        "--> mpsflow FATAL ERROR: {case}/system/solverDict:20:5: unknown key 'bta' in 'MPSCoeffs' (did you mean 'beta'?); valid keys: reNumberDensity, reGradient, reLaplacian, beta, relaxation, compressibility, clipNegativePressure, gradientPmin, gradientWeight, wallPressureExtrapolated, velocityFilter, scheme, source, densityFactor, gradient, laplacian, shifting, shiftCoefficient, shiftMax, surfaceDetection, asymmetry, retrySource, collision, collisionAfterCorrection, collisionDistance, restitution, reorderInterval, viscosity, periodicLength, periodicOrigin, wall",
     'wallPressureExtrapolated, gradient corrected':
         "--> mpsflow FATAL ERROR: {case}/system/solverDict:20:16: key 'wallPressureExtrapolated': it continues the walls' pressure for gradient paper (eq. 5) only; set it to no there",
     'gradientWeight, gradient leastSquares':

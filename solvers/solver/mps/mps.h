@@ -35,10 +35,7 @@ typedef struct mps_settings {
     bool gradient_pmin;       /* eq. 5 with p_min (Koshizuka et al. 1998) */
     const char *gradient_weight; /* eq. 5's weight: paper | wendland | wendlandW (mf_grad_weight) */
     bool wall_pressure_extrapolated; /* the gradient reads the walls' p from the fluid's (mps_wall_pressure.c) */
-    bool dynamic_stabilisation; /* DS after the correction (Tsuruta et al. 2013, mps_ds.c) */
-    double ds_distance;       /* DS: pairs closer than this, in l0 */
     double velocity_filter;   /* XSPH eps after the correction (Monaghan 1989, mps_xsph.c; 0: off) */
-    double repulsion_radius;  /* eq. 5's (p_i - p^_i) part at this radius, in l0 (0: eq. 5 as is) */
     /* The scheme (mps_scheme.c): a named set of the five choices below,
      * each of which a case may set apart ("scheme": the scheme's). */
     const char *scheme;       /* paper | robust | stabilised */
@@ -101,11 +98,10 @@ typedef struct mps_data {
     mps_settings s;
     mps_scheme sc;                 /* the resolved choices of s */
     mf_kernel k_nd, k_grad, k_lap; /* one kernel per operator radius */
-    mf_kernel k_rep;               /* repulsionRadius's (mps_repulsion.c) */
     /* Neighbour requests (sim->neighbours), all in the order of cells of the
      * largest radius: that radius, each operator's, and the collision's. */
     mf_neighbours *nb;
-    int h_max, h_nd, h_grad, h_lap, h_coll, h_ds, h_rep;
+    int h_max, h_nd, h_grad, h_lap, h_coll;
     /* Field indices in the particle storage. */
     int f_pressure, f_number_density, f_flags;
     /* Pressure module. */
@@ -183,7 +179,7 @@ typedef struct mps_data {
 enum { MPS_FLAG_SURFACE = 1 }; /* bits of the Flags field */
 
 extern const mf_solver_ops mf_solver_MPS;
-#define MPS_NPARAMS 34 /* checked against the table in mps_params.c */
+#define MPS_NPARAMS 31 /* checked against the table in mps_params.c */
 extern const mf_param mps_params[MPS_NPARAMS];
 extern const char *const mps_viscosity_choices[]; /* explicit, implicit */
 extern const char *const mps_wall_choices[];      /* particles, wallWeight */
@@ -234,18 +230,9 @@ extern const char *const mps_scheme_choices[], *const mps_source_choices[],
      OFF(wall_pressure_extrapolated),                                                           \
      "the pressure gradient takes the wall particles' pressure from their fluid neighbours' "   \
      "(Adami, Hu & Adams 2012, eq. 27) instead of the PPE's (gradient paper, wall particles)"}, \
-    {"dynamicStabilisation", MF_PARAM_BOOL, "no", MF_NO_RANGE, NULL,                            \
-     OFF(dynamic_stabilisation),                                                                \
-     "after the correction, approaching pairs closer than dsDistance get the pair velocity "   \
-     "that takes them back to it in one step, shared by mass (Tsuruta, Khayyer & Gotoh 2013)"}, \
-    {"dsDistance", MF_PARAM_SCALAR, "0.9", 0.1, 1.5, NULL, OFF(ds_distance),                   \
-     "dynamicStabilisation: the pair distance it keeps, in l0"},                               \
     {"velocityFilter", MF_PARAM_SCALAR, "0", 0, 1, NULL, OFF(velocity_filter),               \
      "after the correction each fluid velocity moves by eps (1/n0) sum_j (u_j - u_i) w_ij "     \
      "towards its fluid neighbours' (XSPH, Monaghan 1989, applied to the velocity; 0: off)"},  \
-    {"repulsionRadius", MF_PARAM_SCALAR, "0", 0, 10, NULL, OFF(repulsion_radius),              \
-     "gradient paper: eq. 5 split into its consistent part sum (p_j - p_i) at reGradient and " \
-     "its repulsive part (p_i - p^_i) sum r w / r^2 at this radius, in l0 (0: eq. 5 as is)"},  \
     {"scheme", MF_PARAM_WORD, SCHEME, MF_NO_RANGE, mps_scheme_choices, OFF(scheme),             \
      "the scheme: the defaults of source, gradient, laplacian, shifting, surfaceDetection "      \
      "and collision (paper: eqs. 5, 7, 14, 18 as printed; robust: mixed source, asymmetry "     \
@@ -374,12 +361,8 @@ int mps_bodies_pressure(mps_data *d, mf_sim *sim, const double *pressure);
 
 /* mps_shift.c: particle shifting after the correction (Lind et al. 2012). */
 int mps_shift(mps_data *d, mf_sim *sim);
-/* mps_ds.c: dynamic stabilisation after the correction (Tsuruta et al. 2013). */
-int mps_dynamic_stabilisation(mps_data *d, mf_sim *sim, double dt);
 /* mps_xsph.c: the XSPH velocity filter after the correction (Monaghan 1989). */
 int mps_velocity_filter(mps_data *d, mf_sim *sim, double dt);
-/* mps_repulsion.c: eq. 5 with its repulsive part at repulsionRadius, into d->grad. */
-int mps_gradient_split(mps_data *d, mf_sim *sim, const mf_pairs *v, const double *pr);
 
 /* mps_ppe.c */
 int mps_assemble_ppe(mps_data *d, const mf_sim *sim, double dt);

@@ -94,7 +94,6 @@ static int request_neighbours(mps_data *d, mf_sim *sim)
     double rmax = d->k_nd.re;
     if (d->k_grad.re > rmax) rmax = d->k_grad.re;
     if (d->k_lap.re > rmax) rmax = d->k_lap.re;
-    if (d->s.repulsion_radius > 0 && d->k_rep.re > rmax) rmax = d->k_rep.re;
     MF_CALL(mf_neighbours_request(d->nb, rmax, rmax, &d->h_max));
     MF_CALL(mf_neighbours_request(d->nb, d->k_nd.re, rmax, &d->h_nd));
     MF_CALL(mf_neighbours_request(d->nb, d->k_grad.re, rmax, &d->h_grad));
@@ -103,13 +102,6 @@ static int request_neighbours(mps_data *d, mf_sim *sim)
     d->h_coll = -1;
     if (d->s.collision)
         MF_CALL(mf_neighbours_request(d->nb, dc < rmax ? dc : rmax, rmax, &d->h_coll));
-    const double dds = d->s.ds_distance * sim->l0;
-    d->h_rep = -1;
-    if (d->s.repulsion_radius > 0)
-        MF_CALL(mf_neighbours_request(d->nb, d->k_rep.re, rmax, &d->h_rep));
-    d->h_ds = -1;
-    if (d->s.dynamic_stabilisation)
-        MF_CALL(mf_neighbours_request(d->nb, dds < rmax ? dds : rmax, rmax, &d->h_ds));
     return 0;
 }
 
@@ -172,36 +164,17 @@ static int gradient_weight(const mps_settings *s, const mps_scheme *sc,
     return mf_kernel_set_gradient_weight(k, shape);
 }
 
-/* repulsionRadius: eq. 5 split (mps_repulsion.c) where the correction
- * takes eq. 5 as is (gradient paper, paper weight, particle walls, one
- * fluid); its kernel at that radius. Refused elsewhere, with the key. */
-static int refuse_repulsion(const mps_settings *s, const mps_scheme *sc,
-                            const mf_dict *solver_dict, const mf_kernel *k_grad, mf_kernel *k_rep,
-                            const mf_sim *sim)
-{
-    const char *why = NULL;
-    if (sc->gradient != MPS_GRADIENT_PAPER)
-        why = "it splits eq. 5 (gradient paper) only";
-    else if (k_grad->grad_weight != MF_GRAD_WEIGHT_PAPER)
-        why = "it splits eq. 5 with the paper's weight only (gradientWeight paper)";
-    else if (sim->nfluids > 1)
-        why = "it splits eq. 5 of one fluid (not with several fluids)";
-    else if (!s->gradient_pmin)
-        why = "with gradientPmin no eq. 5 has no repulsive part to split";
-    if (why) {
-        char where[512];
-        return MF_ERROR(MF_ERR_INPUT, "%s: key 'repulsionRadius': %s; set it to 0 there",
-                        mps_key_where(solver_dict, "repulsionRadius", where, sizeof where),
-                        why);
-    }
-    return mf_kernel_init(k_rep, sim->dim, sim->l0, s->repulsion_radius * sim->l0);
-}
-
 int mps_create_data(const mps_settings *s, mf_sim *sim, const mf_dict *solver_dict,
                     mps_data **out)
 {
     if (s->periodic_length > 0)
         return MF_ERROR(MF_ERR_INPUT, "periodicLength: only solver MPS has a periodic axis");
+    if (s->velocity_filter > 0) {
+        char where[512];
+        return MF_ERROR(MF_ERR_INPUT, "%s: key 'velocityFilter': only solver MPS has it (a "
+                        "composing solver's phases do not take it); set it to 0 there",
+                        mps_key_where(solver_dict, "velocityFilter", where, sizeof where));
+    }
     /* mps_create takes the key away for solver MPS; a composing solver
      * (MAFL's Eulerian points, multiFluid's density per particle) has no
      * wall terms yet. */
@@ -221,8 +194,6 @@ int mps_create_data(const mps_settings *s, mf_sim *sim, const mf_dict *solver_di
     MF_CALL(mf_kernel_init(&d->k_grad, sim->dim, sim->l0, s->re_gradient * sim->l0));
     MF_CALL(gradient_weight(s, &d->sc, solver_dict, &d->k_grad));
     MF_CALL(mf_kernel_init(&d->k_lap, sim->dim, sim->l0, s->re_laplacian * sim->l0));
-    if (s->repulsion_radius > 0)
-        MF_CALL(refuse_repulsion(s, &d->sc, solver_dict, &d->k_grad, &d->k_rep, sim));
     MF_CALL(request_neighbours(d, sim));
     sim->n0 = d->k_nd.n0; /* the NumberDensity field's reference, for the run's watch */
     d->rho_default = sim->fluid[0].rho;
@@ -300,10 +271,14 @@ static int mps_create(const void *settings, mf_sim *sim, const mf_dict *solver_d
     mps_settings s = *(const mps_settings *)settings;
     const double period = s.periodic_length;
     const char *wall = s.wall;
+    const double velocity_filter = s.velocity_filter;
     s.periodic_length = 0;
+    s.velocity_filter = 0;
     s.wall = "particles";
     mps_data *d = NULL;
     int rc = mps_create_data(&s, sim, solver_dict, &d);
+    if (rc == 0) /* the XSPH filter after the correction (mps_xsph.c) */
+        d->s.velocity_filter = velocity_filter;
     if (rc == 0 && period > 0) { /* the halo of mps_create_data gains the period */
         mps_halo_destroy(d->halo);
         d->halo = NULL;

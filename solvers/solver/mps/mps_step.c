@@ -332,8 +332,7 @@ int mps_correction_phase(mps_data *d, mf_sim *sim, double dt)
         mps_apply_correction(d, p, dt, NULL);
         if (!d->rho && d->s.collision && d->s.collision_after_correction)
             MF_CALL(collide(d, sim, dt));
-        MF_CALL(mps_dynamic_stabilisation(d, sim, dt));
-    MF_CALL(mps_velocity_filter(d, sim, dt));
+        MF_CALL(mps_velocity_filter(d, sim, dt));
         d->t_correction += mf_wall_seconds() - t0;
         MF_CALL(mps_shift(d, sim));
         return 0;
@@ -349,10 +348,7 @@ int mps_correction_phase(mps_data *d, mf_sim *sim, double dt)
         MF_CALL(mps_halo_sync(d, sim, d->work, sizeof *d->work));
         pr = d->work;
     }
-    if (d->s.repulsion_radius > 0) /* eq. 5's repulsive part at its own radius */
-        MF_CALL(mps_gradient_split(d, sim, &v, pr));
-    else
-        mf_gradient(&v, &d->k_grad, pr, d->s.gradient_pmin, d->is_fluid, d->not_dummy, d->grad);
+    mf_gradient(&v, &d->k_grad, pr, d->s.gradient_pmin, d->is_fluid, d->not_dummy, d->grad);
     MF_CALL(mps_bodies_pressure(d, sim, pr)); /* the rigid bodies' share, at r* */
     const double rho = sim->fluid[0].rho;
     if (d->wall) { /* the walls' part, with eq. 5's p^ of each particle */
@@ -375,7 +371,6 @@ int mps_correction_phase(mps_data *d, mf_sim *sim, double dt)
             MF_CALL(mps_halo_sync_motion(d, sim));
         MF_CALL(collide(d, sim, dt));
     }
-    MF_CALL(mps_dynamic_stabilisation(d, sim, dt));
     MF_CALL(mps_velocity_filter(d, sim, dt));
     d->t_correction += mf_wall_seconds() - t0;
     MF_CALL(mps_shift(d, sim));

@@ -130,8 +130,6 @@ int mps_wall_create(mps_data *d, mf_sim *sim, const mf_dict *solver_dict)
         why = "wallPressureExtrapolated continues the pressure to wall particles (set it to no)";
     else if (d->k_grad.grad_weight != MF_GRAD_WEIGHT_PAPER)
         why = "the wall tables integrate the paper's weight (set gradientWeight paper;)";
-    else if (d->s.repulsion_radius > 0)
-        why = "the wall tables have no split eq. 5 (set repulsionRadius 0;)";
     else if (sim->par)
         why = "not on several ranks yet (run it serially)";
     else if (mf_bodies_count(sim->walls) > 0)
