@@ -232,7 +232,8 @@ extern const char *const mps_scheme_choices[], *const mps_source_choices[],
      "(Adami, Hu & Adams 2012, eq. 27) instead of the PPE's (gradient paper, wall particles)"}, \
     {"velocityFilter", MF_PARAM_SCALAR, "0", 0, 1, NULL, OFF(velocity_filter),               \
      "after the correction each fluid velocity moves by eps (1/n0) sum_j (u_j - u_i) w_ij "     \
-     "towards its fluid neighbours' (XSPH, Monaghan 1989, applied to the velocity; 0: off)"},  \
+     "towards its fluid neighbours' (XSPH, Monaghan 1989, applied to the velocity; solver MPS "  \
+     "only; 0: off)"},                                                                          \
     {"scheme", MF_PARAM_WORD, SCHEME, MF_NO_RANGE, mps_scheme_choices, OFF(scheme),             \
      "the scheme: the defaults of source, gradient, laplacian, shifting, surfaceDetection "      \
      "and collision (paper: eqs. 5, 7, 14, 18 as printed; robust: mixed source, asymmetry "     \
