@@ -35,7 +35,7 @@ typedef struct mps_settings {
     bool gradient_pmin;       /* eq. 5 with p_min (Koshizuka et al. 1998) */
     const char *gradient_weight; /* eq. 5's weight: paper | wendland | wendlandW (mf_grad_weight) */
     bool wall_pressure_extrapolated; /* the gradient reads the walls' p from the fluid's (mps_wall_pressure.c) */
-    double velocity_filter;   /* XSPH eps after the correction (Monaghan 1989, mps_xsph.c; 0: off) */
+    double velocity_filter;   /* XSPH eps on u^n in the explicit phase (Monaghan 1989, mps_xsph.c; 0: off) */
     /* The scheme (mps_scheme.c): a named set of the five choices below,
      * each of which a case may set apart ("scheme": the scheme's). */
     const char *scheme;       /* paper | robust | stabilised */
@@ -231,7 +231,7 @@ extern const char *const mps_scheme_choices[], *const mps_source_choices[],
      "the pressure gradient takes the wall particles' pressure from their fluid neighbours' "   \
      "(Adami, Hu & Adams 2012, eq. 27) instead of the PPE's (gradient paper, wall particles)"}, \
     {"velocityFilter", MF_PARAM_SCALAR, "0", 0, 1, NULL, OFF(velocity_filter),               \
-     "after the correction each fluid velocity moves by eps (1/n0) sum_j (u_j - u_i) w_ij "     \
+     "before the explicit update each fluid velocity u^n moves by eps (1/n0) sum_j (u_j - u_i) w_ij "     \
      "towards its fluid neighbours' (XSPH, Monaghan 1989, applied to the velocity; solver MPS "  \
      "only; 0: off)"},                                                                          \
     {"scheme", MF_PARAM_WORD, SCHEME, MF_NO_RANGE, mps_scheme_choices, OFF(scheme),             \
@@ -362,8 +362,8 @@ int mps_bodies_pressure(mps_data *d, mf_sim *sim, const double *pressure);
 
 /* mps_shift.c: particle shifting after the correction (Lind et al. 2012). */
 int mps_shift(mps_data *d, mf_sim *sim);
-/* mps_xsph.c: the XSPH velocity filter after the correction (Monaghan 1989). */
-int mps_velocity_filter(mps_data *d, mf_sim *sim, double dt);
+/* mps_xsph.c: the XSPH velocity filter on u^n in the explicit phase (Monaghan 1989). */
+int mps_velocity_filter(mps_data *d, mf_sim *sim);
 
 /* mps_ppe.c */
 int mps_assemble_ppe(mps_data *d, const mf_sim *sim, double dt);
