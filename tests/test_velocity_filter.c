@@ -1,5 +1,5 @@
 /* test_velocity_filter.c: what MPSCoeffs `velocityFilter` (the XSPH velocity
- * filter after the correction, Monaghan 1989; solvers/solver/mps/mps_xsph.c)
+ * filter on u^n, Monaghan 1989; solvers/solver/mps/mps_xsph.c)
  * does on the resting tank (issue 13; docs/notes/mps.md, "rest").
  *
  * bench/cases/restingTank as it is (2-D, W/H 2, H 0.2 m, l0 0.01, the MPS
@@ -8,9 +8,10 @@
  *   - robust: the column mode and the walls' seed have grown, above 5% of
  *     sqrt(g H) (measured 0.159 sqrt(g H) at 1 s, 2026-12-04);
  *   - with `velocityFilter 0.2;` below a fifth of robust's and below 1% of
- *     sqrt(g H) (measured 0.0044 sqrt(g H) at 1 s, 2026-12-04). It is no fix for issue
- * 13: it stops damBreak2D from eps 0.05 and the l0 0.005 tanks blow up
- * with it (docs/notes/mps.md, "rest"); this checks only what it does here.
+ *     sqrt(g H) (measured 0.0044 sqrt(g H) at 1 s, 2026-12-04).
+ * It is no fix for issue 13: it stops damBreak2D from eps 0.05 and the l0
+ * 0.005 tanks blow up with it (docs/notes/mps.md, "rest"); this checks
+ * only what it does here.
  * Both must end with every fluid particle inside the tank.
  *
  * argv[1]: the mpsflow executable; argv[2]: bench/cases/restingTank. */
