@@ -230,10 +230,10 @@ extern const char *const mps_scheme_choices[], *const mps_source_choices[],
      OFF(wall_pressure_extrapolated),                                                           \
      "the pressure gradient takes the wall particles' pressure from their fluid neighbours' "   \
      "(Adami, Hu & Adams 2012, eq. 27) instead of the PPE's (gradient paper, wall particles)"}, \
-    {"velocityFilter", MF_PARAM_SCALAR, "0", 0, 1, NULL, OFF(velocity_filter),               \
-     "before the explicit update each fluid velocity u^n moves by eps (1/n0) sum_j (u_j - u_i) w_ij "     \
-     "towards its fluid neighbours' (XSPH, Monaghan 1989, applied to the velocity; solver MPS "  \
-     "only; 0: off)"},                                                                          \
+    {"velocityFilter", MF_PARAM_SCALAR, "0", 0, 1, NULL, OFF(velocity_filter),                 \
+     "before the explicit update each fluid velocity u^n moves by eps sum_j c_ij (u_j - u_i) "   \
+     "towards its fluid neighbours', c_ij = w_ij / max(n0, s_i, s_j) (XSPH, Monaghan 1989, "    \
+     "applied to the velocity; solver MPS only; 0: off)"},                                       \
     {"scheme", MF_PARAM_WORD, SCHEME, MF_NO_RANGE, mps_scheme_choices, OFF(scheme),             \
      "the scheme: the defaults of source, gradient, laplacian, shifting, surfaceDetection "      \
      "and collision (paper: eqs. 5, 7, 14, 18 as printed; robust: mixed source, asymmetry "     \
