@@ -113,6 +113,8 @@ CATALOGUE = [
     ("gradientWeight, wall wallWeight", D,
      [("sub", SOLV, r"    beta .*", "    beta 0.97; gradientWeight wendland; wall wallWeight; source mixed;")],
      DRY),
+    ("velocityFilter, solver multiFluid", "waterAirDamBreak",
+     [("sub", SOLV, r"    outerTolerance .*", "    outerTolerance  1e-3; velocityFilter 0.2;")], DRY),
     ("gradientWeight unknown", D, [("sub", SOLV, r"    beta .*", "    beta 0.97; gradientWeight cubic;")],
      DRY),
     ("reLaplacian out of range", D, [("sub", SOLV, r"    reLaplacian .*", "    reLaplacian 50;")],
@@ -446,7 +448,9 @@ EXPECTED.update({
     'unknown top-level key':
         "--> mpsflow FATAL ERROR: {case}/system/solverDict:36:1: unknown key 'MSPCoeffs' in '(top level)' (did you mean 'MPSCoeffs'?); valid keys: solver, pressure, viscosity, forces, FoamFile, MPSCoeffs, multiFluidCoeffs, MAFLCoeffs",
     'unknown coefficient':
-        "--> mpsflow FATAL ERROR: {case}/system/solverDict:20:5: unknown key 'bta' in 'MPSCoeffs' (did you mean 'beta'?); valid keys: reNumberDensity, reGradient, reLaplacian, beta, relaxation, compressibility, clipNegativePressure, gradientPmin, gradientWeight, wallPressureExtrapolated, scheme, source, densityFactor, gradient, laplacian, shifting, shiftCoefficient, shiftMax, surfaceDetection, asymmetry, retrySource, collision, collisionAfterCorrection, collisionDistance, restitution, reorderInterval, viscosity, periodicLength, periodicOrigin, wall",
+        "--> mpsflow FATAL ERROR: {case}/system/solverDict:20:5: unknown key 'bta' in 'MPSCoeffs' (did you mean 'beta'?); valid keys: reNumberDensity, reGradient, reLaplacian, beta, relaxation, compressibility, clipNegativePressure, gradientPmin, gradientWeight, wallPressureExtrapolated, velocityFilter, scheme, source, densityFactor, gradient, laplacian, shifting, shiftCoefficient, shiftMax, surfaceDetection, asymmetry, retrySource, collision, collisionAfterCorrection, collisionDistance, restitution, reorderInterval, viscosity, periodicLength, periodicOrigin, wall",
+    'velocityFilter, solver multiFluid':
+        "--> mpsflow FATAL ERROR: {case}/system/solverDict:34:27: key 'velocityFilter': only solver MPS has it (a composing solver's phases do not take it); set it to 0 there",
     'wallPressureExtrapolated, gradient corrected':
         "--> mpsflow FATAL ERROR: {case}/system/solverDict:20:16: key 'wallPressureExtrapolated': it continues the walls' pressure for gradient paper (eq. 5) only; set it to no there",
     'gradientWeight, gradient leastSquares':

@@ -35,6 +35,7 @@ typedef struct mps_settings {
     bool gradient_pmin;       /* eq. 5 with p_min (Koshizuka et al. 1998) */
     const char *gradient_weight; /* eq. 5's weight: paper | wendland | wendlandW (mf_grad_weight) */
     bool wall_pressure_extrapolated; /* the gradient reads the walls' p from the fluid's (mps_wall_pressure.c) */
+    double velocity_filter;   /* XSPH eps on u^n in the explicit phase (Monaghan 1989, mps_xsph.c; 0: off) */
     /* The scheme (mps_scheme.c): a named set of the five choices below,
      * each of which a case may set apart ("scheme": the scheme's). */
     const char *scheme;       /* paper | robust | stabilised */
@@ -178,7 +179,7 @@ typedef struct mps_data {
 enum { MPS_FLAG_SURFACE = 1 }; /* bits of the Flags field */
 
 extern const mf_solver_ops mf_solver_MPS;
-#define MPS_NPARAMS 30 /* checked against the table in mps_params.c */
+#define MPS_NPARAMS 31 /* checked against the table in mps_params.c */
 extern const mf_param mps_params[MPS_NPARAMS];
 extern const char *const mps_viscosity_choices[]; /* explicit, implicit */
 extern const char *const mps_wall_choices[];      /* particles, wallWeight */
@@ -229,6 +230,10 @@ extern const char *const mps_scheme_choices[], *const mps_source_choices[],
      OFF(wall_pressure_extrapolated),                                                           \
      "the pressure gradient takes the wall particles' pressure from their fluid neighbours' "   \
      "(Adami, Hu & Adams 2012, eq. 27) instead of the PPE's (gradient paper, wall particles)"}, \
+    {"velocityFilter", MF_PARAM_SCALAR, "0", 0, 1, NULL, OFF(velocity_filter),                 \
+     "before the explicit update each fluid velocity u^n moves by eps sum_j c_ij (u_j - u_i) "   \
+     "towards its fluid neighbours', c_ij = w_ij / max(n0, s_i, s_j) (XSPH, Monaghan 1989, "    \
+     "applied to the velocity; solver MPS only; 0: off)"},                                       \
     {"scheme", MF_PARAM_WORD, SCHEME, MF_NO_RANGE, mps_scheme_choices, OFF(scheme),             \
      "the scheme: the defaults of source, gradient, laplacian, shifting, surfaceDetection "      \
      "and collision (paper: eqs. 5, 7, 14, 18 as printed; robust: mixed source, asymmetry "     \
@@ -357,6 +362,8 @@ int mps_bodies_pressure(mps_data *d, mf_sim *sim, const double *pressure);
 
 /* mps_shift.c: particle shifting after the correction (Lind et al. 2012). */
 int mps_shift(mps_data *d, mf_sim *sim);
+/* mps_xsph.c: the XSPH velocity filter on u^n in the explicit phase (Monaghan 1989). */
+int mps_velocity_filter(mps_data *d, mf_sim *sim);
 
 /* mps_ppe.c */
 int mps_assemble_ppe(mps_data *d, const mf_sim *sim, double dt);

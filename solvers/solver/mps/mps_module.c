@@ -169,6 +169,12 @@ int mps_create_data(const mps_settings *s, mf_sim *sim, const mf_dict *solver_di
 {
     if (s->periodic_length > 0)
         return MF_ERROR(MF_ERR_INPUT, "periodicLength: only solver MPS has a periodic axis");
+    if (s->velocity_filter > 0) {
+        char where[512];
+        return MF_ERROR(MF_ERR_INPUT, "%s: key 'velocityFilter': only solver MPS has it (a "
+                        "composing solver's phases do not take it); set it to 0 there",
+                        mps_key_where(solver_dict, "velocityFilter", where, sizeof where));
+    }
     /* mps_create takes the key away for solver MPS; a composing solver
      * (MAFL's Eulerian points, multiFluid's density per particle) has no
      * wall terms yet. */
@@ -265,10 +271,14 @@ static int mps_create(const void *settings, mf_sim *sim, const mf_dict *solver_d
     mps_settings s = *(const mps_settings *)settings;
     const double period = s.periodic_length;
     const char *wall = s.wall;
+    const double velocity_filter = s.velocity_filter;
     s.periodic_length = 0;
+    s.velocity_filter = 0;
     s.wall = "particles";
     mps_data *d = NULL;
     int rc = mps_create_data(&s, sim, solver_dict, &d);
+    if (rc == 0) /* the XSPH filter after the correction (mps_xsph.c) */
+        d->s.velocity_filter = velocity_filter;
     if (rc == 0 && period > 0) { /* the halo of mps_create_data gains the period */
         mps_halo_destroy(d->halo);
         d->halo = NULL;

@@ -195,6 +195,7 @@ int mps_explicit_phase(mps_data *d, mf_sim *sim, double dt)
     if (d->wall && nu > 0 && (d->mu || d->sc.laplacian != MPS_LAPLACIAN_LEAST_SQUARES))
         mps_wall_viscous(d, sim, nu);
     MF_CALL(mps_bodies_viscous(d, sim)); /* the rigid bodies' share, at r^n */
+    MF_CALL(mps_velocity_filter(d, sim)); /* on u^n, before u* (mps_xsph.c) */
     for (size_t i = 0; i < p->n_owned && !d->visc; i++) {
         if (!d->is_fluid[i])
             continue;
