@@ -170,6 +170,12 @@ extern const size_t mf_motion_nsections;
  * A tank's closed faces are whole planes here: its solid is everything
  * behind any of them. */
 double mf_wall_distance(const mf_wall *w, const double x[3], double n[3]);
+/* The box that particles on a box obstacle's lattice min + (i + 1/2) l0
+ * stand for: max[a] becomes min[a] + n l0 (n = floor((max - min) / l0), the
+ * particles along the axis) where that differs from the asked size by more
+ * than 1e-6 l0 (scene_solids.c: the obstacle's record; the containment
+ * metric: "inside the obstacle"). */
+void mf_box_lattice_max(double l0, int dim, const double min[3], double max[3]);
 /* True when fluid at x has gone through the solid: past a closed face of a
  * tank by more than l0/2 within that face's extent (the line of its first
  * wall particles; *axis, *side say which face), or inside an obstacle's

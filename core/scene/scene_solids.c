@@ -191,32 +191,13 @@ static int place(mf_sim *sim, const double x[3], double depth, long wall_layers,
     return mf_particles_add(sim->p, kind, x, v0, NULL);
 }
 
-/* The number of lattice points of a box obstacle along each axis. */
+/* The number of lattice points of a box obstacle along each axis (the
+ * rule of mf_box_lattice_max). */
 static void box_counts(const mf_sim *sim, const double mn[3], const double mx[3], long n[3])
 {
     n[0] = n[1] = n[2] = 1;
     for (int a = 0; a < sim->dim; a++)
         n[a] = (long)floor((mx[a] - mn[a]) / sim->l0 + 1e-9);
-}
-
-/* A box obstacle's record is the box its particles stand for, [min, min +
- * n l0] (n = box_counts), not the asked one when the lattice makes it
- * smaller (the scene summary warns): the watch's throughWall test and a
- * rigid body's faces and contacts must see the solid the fluid's pressure
- * sees. At 0.00487 the tutorial damBreakObstacle's 0.024 m block is 4
- * particles, 0.01948 m: a fluid particle resting 0.93 l0 beside its last
- * wall column was "inside obstacle 'block'" by the asked box's face
- * (docs/notes/mps.md, "The obstacle at three spacings"). A size within
- * 1e-6 l0 of the lattice's is kept as asked (the record bit for bit). */
-static void box_to_lattice(const mf_sim *sim, mf_wall *w)
-{
-    long n[3];
-    box_counts(sim, w->min, w->max, n);
-    for (int a = 0; a < sim->dim; a++) {
-        const double size = (double)n[a] * sim->l0;
-        if (fabs(size - (w->max[a] - w->min[a])) > 1e-6 * sim->l0)
-            w->max[a] = w->min[a] + size;
-    }
 }
 
 static int fill_box(mf_sim *sim, const obstacle_settings *s)
@@ -323,7 +304,15 @@ int mf_scene_obstacle(mf_sim *sim, const char *name, const mf_dict *d, mf_dict *
             for (int a = 0; a < 3; a++)
                 want[a] = s.max[a] - s.min[a];
             mf_scene_warn_extent(sim, w.where, "obstacle", name, want, first, -1);
-            box_to_lattice(sim, &w);
+            /* The record is the box the particles stand for, not the asked
+             * one when the lattice makes it smaller (warned just above): the
+             * watch's throughWall test and a rigid body's faces and contacts
+             * must see the solid the fluid's pressure sees. At l0 0.00487 the
+             * tutorial damBreakObstacle's 0.024 m block is 4 particles,
+             * 0.01948 m: fluid 0.93 l0 beside its last wall column was
+             * "inside obstacle 'block'" by the asked face (docs/notes/mps.md,
+             * "The obstacle at three spacings"). */
+            mf_box_lattice_max(sim->l0, sim->dim, w.min, w.max);
         }
     }
     if (rc == 0) {

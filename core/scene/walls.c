@@ -214,6 +214,15 @@ double mf_wall_distance(const mf_wall *w, const double x[3], double n[3])
     return d;
 }
 
+void mf_box_lattice_max(double l0, int dim, const double min[3], double max[3])
+{
+    for (int a = 0; a < dim; a++) {
+        const double size = floor((max[a] - min[a]) / l0 + 1e-9) * l0;
+        if (fabs(size - (max[a] - min[a])) > 1e-6 * l0)
+            max[a] = min[a] + size;
+    }
+}
+
 bool mf_wall_passed(const mf_wall *w, double l0, int dim, const double x[3], int *axis,
                     int *side)
 {
