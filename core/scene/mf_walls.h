@@ -103,6 +103,8 @@ typedef struct mf_wall {
     /* shape, body frame */
     double min[3], max[3];   /* tank, box */
     bool open[3][2];         /* tank: faces without wall (z faces in 2-D) */
+    double thickness;        /* tank: depth of its particle layers beyond the region, m
+                              * ((wallLayers + dummyLayers) l0; 0: none, wall weight) */
     double centre[3], axis[3], radius, half_length; /* cylinder (half_length 0: endless), sphere */
     struct mf_wall_mesh *mesh;
     double surface_velocity[3]; /* body frame, m/s */
@@ -183,6 +185,14 @@ void mf_box_lattice_max(double l0, int dim, const double min[3], double max[3]);
  * such a particle). */
 bool mf_wall_passed(const mf_wall *w, double l0, int dim, const double x[3], int *axis,
                     int *side);
+
+/* True when fluid at x, past closed face (axis, side) of tank w by
+ * mf_wall_passed, is beyond that face's particle layers as well: outside
+ * the tank, come over the top of the wall (a spill), not through it. A step
+ * moves a particle by maxCo l0 at most (the Courant limit), so one going
+ * through the layers is seen inside them first. False without layers
+ * (thickness 0). */
+bool mf_wall_spilled(const mf_wall *w, const double x[3], int axis, int side);
 
 /* ---- particles of moving solids (walls.c) ----------------------------- */
 /* Move the particles of every moving solid from its state at t_from to its

@@ -253,6 +253,16 @@ bool mf_wall_passed(const mf_wall *w, double l0, int dim, const double x[3], int
     return false;
 }
 
+bool mf_wall_spilled(const mf_wall *w, const double x[3], int axis, int side)
+{
+    if (w->shape != MF_SOLID_TANK || !(w->thickness > 0) || axis < 0 || axis > 2)
+        return false;
+    double xb[3];
+    mf_wall_to_body(w, x, xb);
+    return side == 0 ? xb[axis] < w->min[axis] - w->thickness
+                     : xb[axis] > w->max[axis] + w->thickness;
+}
+
 /* ---- particles of moving solids --------------------------------------------- */
 
 void mf_walls_move_particles(const mf_walls *ws, const mf_rigid_state *from_states,
