@@ -1154,16 +1154,20 @@ static void test_solids(void)
         CHECK(!mf_wall_passed(b, l0b, 2, top, &ax, &sd));
         CHECK(mf_wall_passed(b, l0b, 2, deep, &ax, &sd));
         /* The tank's far wall (3 layers, 0.584 + 3 l0): fluid in its layers
-         * went through it; fluid beyond them came over its top (the splash
-         * at l0 0.00365, t = 0.535 s): the watch lets it go. */
+         * went through it; fluid beyond them, outside before its step too,
+         * came over its top (the splash at l0 0.00365, t = 0.535 s): the
+         * watch lets it go. */
         const mf_wall *tank = &sc.sim.walls->w[0];
         CHECK(fabs(tank->thickness - 3 * l0b) < 1e-15);
         const double in_wall[3] = {0.584 + 2.9 * l0b, 0.5, 0};
         const double over[3] = {0.584 + 3.2 * l0b, 0.5838, 0};
+        const double fall[3] = {0.1 * l0b, -0.1 * l0b, 0}, kick[3] = {3 * l0b, 0, 0};
         CHECK(mf_wall_passed(tank, l0b, 2, in_wall, &ax, &sd) && ax == 0 && sd == 1 &&
-              !mf_wall_spilled(tank, in_wall, ax, sd));
+              !mf_wall_spilled(tank, l0b, in_wall, fall, ax, sd));
         CHECK(mf_wall_passed(tank, l0b, 2, over, &ax, &sd) && ax == 0 && sd == 1 &&
-              mf_wall_spilled(tank, over, ax, sd));
+              mf_wall_spilled(tank, l0b, over, fall, ax, sd));
+        /* ... but not one kicked through the wall in one step. */
+        CHECK(!mf_wall_spilled(tank, l0b, over, kick, ax, sd));
     }
     scene_free(&sc);
     /* An exact box keeps its record as asked, bit for bit. */

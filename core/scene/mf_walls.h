@@ -187,12 +187,15 @@ bool mf_wall_passed(const mf_wall *w, double l0, int dim, const double x[3], int
                     int *side);
 
 /* True when fluid at x, past closed face (axis, side) of tank w by
- * mf_wall_passed, is beyond that face's particle layers as well: outside
- * the tank, come over the top of the wall (a spill), not through it. A step
- * moves a particle by maxCo l0 at most (the Courant limit), so one going
- * through the layers is seen inside them first. False without layers
- * (thickness 0). */
-bool mf_wall_spilled(const mf_wall *w, const double x[3], int axis, int side);
+ * mf_wall_passed, is beyond that face's particle layers as well and was
+ * past the face's wall-particle line (l0/2 outside the region) before its
+ * last step `step` (its displacement, dt u) too: it is outside the tank,
+ * come over the top of the wall (a spill), not through it. One going
+ * through is seen in the layers (a step moves a particle maxCo l0 at most,
+ * the Courant limit) or crossing the line in the step (a kick). False
+ * without layers (thickness 0). */
+bool mf_wall_spilled(const mf_wall *w, double l0, const double x[3], const double step[3],
+                     int axis, int side);
 
 /* ---- particles of moving solids (walls.c) ----------------------------- */
 /* Move the particles of every moving solid from its state at t_from to its

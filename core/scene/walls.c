@@ -253,14 +253,20 @@ bool mf_wall_passed(const mf_wall *w, double l0, int dim, const double x[3], int
     return false;
 }
 
-bool mf_wall_spilled(const mf_wall *w, const double x[3], int axis, int side)
+bool mf_wall_spilled(const mf_wall *w, double l0, const double x[3], const double step[3],
+                     int axis, int side)
 {
     if (w->shape != MF_SOLID_TANK || !(w->thickness > 0) || axis < 0 || axis > 2)
         return false;
-    double xb[3];
+    double before[3], xb[3], bb[3];
+    for (int a = 0; a < 3; a++)
+        before[a] = x[a] - step[a];
     mf_wall_to_body(w, x, xb);
-    return side == 0 ? xb[axis] < w->min[axis] - w->thickness
-                     : xb[axis] > w->max[axis] + w->thickness;
+    mf_wall_to_body(w, before, bb);
+    const double h = 0.5 * l0;
+    if (side == 0)
+        return xb[axis] < w->min[axis] - w->thickness && bb[axis] < w->min[axis] - h;
+    return xb[axis] > w->max[axis] + w->thickness && bb[axis] > w->max[axis] + h;
 }
 
 /* ---- particles of moving solids --------------------------------------------- */
