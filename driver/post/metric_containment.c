@@ -7,9 +7,9 @@
  * spacing a particle sits from it) and those inside the obstacle's box
  * (obstacleMin, obstacleMax, shrunk by l0/2; with wall particles, the box
  * they stand for, mf_box_lattice_max: the box the run's watch sees, smaller
- * than asked where the size is not a multiple of l0). error = the largest over the
- * snapshots of (|N - N_first| + outside + inside) / N_first: 0 for a run that
- * keeps its fluid where it belongs. The CSV lists (t, N, outside, inside). */
+ * than asked where the size is not a multiple of l0). error = the largest
+ * over the snapshots of (|N - N_first| + outside + inside) / N_first: 0 for
+ * a run that keeps its fluid where it belongs. The CSV lists (t, N, outside, inside). */
 #include <math.h>
 #include <stddef.h>
 #include <stdlib.h>
