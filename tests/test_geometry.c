@@ -1120,6 +1120,66 @@ static void test_solids(void)
               "log: %s", sc.log_text);
     CHECK_MSG(!strstr(sc.log_text, "fluid block 'f'"), "log: %s", sc.log_text);
     scene_free(&sc);
+
+    /* The solid's record is the box its particles stand for: the tutorial
+     * damBreakObstacle's block (0.024 x 0.048 m at x = 0.292) at l0 = 0.00487
+     * is 4 x 9 particles, [0.292, 0.31148] x [0, 0.04383]. Fluid at rest
+     * l0 beside the last wall column (x = 0.309045 + l0), even 0.93 l0 from
+     * it (the throughWall that stopped the run at t = 0.445 s with the
+     * asked box), is outside it; a point l0/2 past the particles' face is
+     * inside it by more than l0/2 (docs/notes/mps.md). */
+    const double l0b = 0.00487;
+    CHECK_MSG(scene_build(&sc, "dimension 2; particleSpacing 0.00487;"
+                               "fluidBlocks { f { type box; min (0 0 0); max (0.146 0.292 0); "
+                               "fluid water; } }"
+                               "walls { tank { type box; min (0 0 0); max (0.584 0.584 0); "
+                               "open (ymax); } }"
+                               "obstacles { block { type box; min (0.292 0 0); "
+                               "max (0.316 0.048 0); } }")
+                  == 0, "%s", sc.error);
+    if (sc.rc == 0) {
+        const mf_wall *b = &sc.sim.walls->w[1];
+        CHECK_MSG(fabs(b->max[0] - (0.292 + 4 * l0b)) < 1e-12 &&
+                      fabs(b->max[1] - 9 * l0b) < 1e-12 && b->min[0] == 0.292 &&
+                      b->min[1] == 0,
+                  "block record [%.17g %.17g] x [%.17g %.17g]", b->min[0], b->max[0],
+                  b->min[1], b->max[1]);
+        int ax, sd;
+        const double last = 0.292 + 3.5 * l0b; /* the last wall column */
+        const double rest[3] = {last + l0b, 0.0196, 0}, close[3] = {last + 0.927 * l0b, 0.0196, 0};
+        const double top[3] = {0.30, 9 * l0b - 0.3 * l0b, 0};
+        const double deep[3] = {0.292 + 3.4 * l0b, 0.0196, 0};
+        CHECK(!mf_wall_passed(b, l0b, 2, rest, &ax, &sd));
+        CHECK(!mf_wall_passed(b, l0b, 2, close, &ax, &sd));
+        CHECK(!mf_wall_passed(b, l0b, 2, top, &ax, &sd));
+        CHECK(mf_wall_passed(b, l0b, 2, deep, &ax, &sd));
+        /* The tank's far wall (3 layers, 0.584 + 3 l0): fluid in its layers
+         * went through it; fluid beyond them, outside before its step too,
+         * came over its top (the splash at l0 0.00365, t = 0.535 s): the
+         * watch lets it go. */
+        const mf_wall *tank = &sc.sim.walls->w[0];
+        CHECK(fabs(tank->thickness - 3 * l0b) < 1e-15);
+        const double in_wall[3] = {0.584 + 2.9 * l0b, 0.5, 0};
+        const double over[3] = {0.584 + 3.2 * l0b, 0.5838, 0};
+        const double fall[3] = {0.1 * l0b, -0.1 * l0b, 0}, kick[3] = {3 * l0b, 0, 0};
+        CHECK(mf_wall_passed(tank, l0b, 2, in_wall, &ax, &sd) && ax == 0 && sd == 1 &&
+              !mf_wall_spilled(tank, l0b, in_wall, fall, ax, sd));
+        CHECK(mf_wall_passed(tank, l0b, 2, over, &ax, &sd) && ax == 0 && sd == 1 &&
+              mf_wall_spilled(tank, l0b, over, fall, ax, sd));
+        /* ... but not one kicked through the wall in one step. */
+        CHECK(!mf_wall_spilled(tank, l0b, over, kick, ax, sd));
+    }
+    scene_free(&sc);
+    /* An exact box keeps its record as asked, bit for bit. */
+    CHECK_MSG(scene_build(&sc, "dimension 2; particleSpacing 0.01;"
+                               "fluidBlocks { f { type box; min (0 0 0); max (0.3 0.2 0); "
+                               "fluid water; } }"
+                               "walls { tank { type box; min (0 0 0); max (1 0.5 0); } }"
+                               "obstacles { b { type box; min (0.5 0 0); max (0.7 0.3 0); } }")
+                  == 0, "%s", sc.error);
+    if (sc.rc == 0)
+        CHECK(sc.sim.walls->w[1].max[0] == 0.7 && sc.sim.walls->w[1].max[1] == 0.3);
+    scene_free(&sc);
     CHECK_MSG(scene_build(&sc, "dimension 2; particleSpacing 0.02;"
                                "fluidBlocks { f { type box; min (0 0 0); max (0.25 0.5 0); "
                                "fluid water; } }"

@@ -103,6 +103,8 @@ typedef struct mf_wall {
     /* shape, body frame */
     double min[3], max[3];   /* tank, box */
     bool open[3][2];         /* tank: faces without wall (z faces in 2-D) */
+    double thickness;        /* tank: depth of its particle layers beyond the region, m
+                              * ((wallLayers + dummyLayers) l0; 0: none, wall weight) */
     double centre[3], axis[3], radius, half_length; /* cylinder (half_length 0: endless), sphere */
     struct mf_wall_mesh *mesh;
     double surface_velocity[3]; /* body frame, m/s */
@@ -170,6 +172,12 @@ extern const size_t mf_motion_nsections;
  * A tank's closed faces are whole planes here: its solid is everything
  * behind any of them. */
 double mf_wall_distance(const mf_wall *w, const double x[3], double n[3]);
+/* The box that particles on a box obstacle's lattice min + (i + 1/2) l0
+ * stand for: max[a] becomes min[a] + n l0 (n = floor((max - min) / l0), the
+ * particles along the axis) where that differs from the asked size by more
+ * than 1e-6 l0 (scene_solids.c: the obstacle's record; the containment
+ * metric: "inside the obstacle"). */
+void mf_box_lattice_max(double l0, int dim, const double min[3], double max[3]);
 /* True when fluid at x has gone through the solid: past a closed face of a
  * tank by more than l0/2 within that face's extent (the line of its first
  * wall particles; *axis, *side say which face), or inside an obstacle's
@@ -177,6 +185,17 @@ double mf_wall_distance(const mf_wall *w, const double x[3], double n[3]);
  * such a particle). */
 bool mf_wall_passed(const mf_wall *w, double l0, int dim, const double x[3], int *axis,
                     int *side);
+
+/* True when fluid at x, past closed face (axis, side) of tank w by
+ * mf_wall_passed, is beyond that face's particle layers as well and was
+ * past the face's wall-particle line (l0/2 outside the region) before its
+ * last step `step` (its displacement, dt u) too: it is outside the tank,
+ * come over the top of the wall (a spill), not through it. One going
+ * through is seen in the layers (a step moves a particle maxCo l0 at most,
+ * the Courant limit) or crossing the line in the step (a kick). False
+ * without layers (thickness 0). */
+bool mf_wall_spilled(const mf_wall *w, double l0, const double x[3], const double step[3],
+                     int axis, int side);
 
 /* ---- particles of moving solids (walls.c) ----------------------------- */
 /* Move the particles of every moving solid from its state at t_from to its

@@ -364,6 +364,8 @@ static int add_wall_box(mf_sim *sim, const char *name, const mf_dict *d, mf_dict
     memcpy(w.open, open, sizeof w.open);
     if (sim->dim == 2) /* no z faces in 2-D */
         w.open[2][0] = w.open[2][1] = true;
+    if (!sim->wall_weight)
+        w.thickness = (double)(s.wall_layers + s.dummy_layers) * sim->l0;
     const size_t first = sim->p->n;
     int rc = sim->wall_weight ? 0 : add_wall_particles(sim, &s, open);
     if (rc == 0)

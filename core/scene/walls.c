@@ -214,6 +214,15 @@ double mf_wall_distance(const mf_wall *w, const double x[3], double n[3])
     return d;
 }
 
+void mf_box_lattice_max(double l0, int dim, const double min[3], double max[3])
+{
+    for (int a = 0; a < dim; a++) {
+        const double size = floor((max[a] - min[a]) / l0 + 1e-9) * l0;
+        if (fabs(size - (max[a] - min[a])) > 1e-6 * l0)
+            max[a] = min[a] + size;
+    }
+}
+
 bool mf_wall_passed(const mf_wall *w, double l0, int dim, const double x[3], int *axis,
                     int *side)
 {
@@ -242,6 +251,22 @@ bool mf_wall_passed(const mf_wall *w, double l0, int dim, const double x[3], int
             }
         }
     return false;
+}
+
+bool mf_wall_spilled(const mf_wall *w, double l0, const double x[3], const double step[3],
+                     int axis, int side)
+{
+    if (w->shape != MF_SOLID_TANK || !(w->thickness > 0) || axis < 0 || axis > 2)
+        return false;
+    double before[3], xb[3], bb[3];
+    for (int a = 0; a < 3; a++)
+        before[a] = x[a] - step[a];
+    mf_wall_to_body(w, x, xb);
+    mf_wall_to_body(w, before, bb);
+    const double h = 0.5 * l0;
+    if (side == 0)
+        return xb[axis] < w->min[axis] - w->thickness && bb[axis] < w->min[axis] - h;
+    return xb[axis] > w->max[axis] + w->thickness && bb[axis] > w->max[axis] + h;
 }
 
 /* ---- particles of moving solids --------------------------------------------- */

@@ -5,9 +5,11 @@
  * Over every snapshot: count the fluid particles, those outside the tank's
  * region (tankMin, tankMax, grown by l0/2: the wall face plus the half
  * spacing a particle sits from it) and those inside the obstacle's box
- * (obstacleMin, obstacleMax, shrunk by l0/2). error = the largest over the
- * snapshots of (|N - N_first| + outside + inside) / N_first: 0 for a run that
- * keeps its fluid where it belongs. The CSV lists (t, N, outside, inside). */
+ * (obstacleMin, obstacleMax, shrunk by l0/2; with wall particles, the box
+ * they stand for, mf_box_lattice_max: the box the run's watch sees, smaller
+ * than asked where the size is not a multiple of l0). error = the largest
+ * over the snapshots of (|N - N_first| + outside + inside) / N_first: 0 for
+ * a run that keeps its fluid where it belongs. The CSV lists (t, N, outside, inside). */
 #include <math.h>
 #include <stddef.h>
 #include <stdlib.h>
@@ -17,6 +19,7 @@
 #include "mf_hdf5.h"
 #include "mf_post.h"
 #include "mf_report.h"
+#include "mf_walls.h"
 
 typedef struct containment_settings {
     const char *metric;
@@ -72,14 +75,20 @@ static int evaluate(const void *settings, const mf_metric_ctx *ctx, double *erro
             break;
         const mf_particles *p = snap.p;
         const double h = 0.5 * snap.l0;
-        size_t n = 0, outside = 0, inside = 0;
+        size_t n = 0, outside = 0, inside = 0, solid = 0;
+        for (size_t i = 0; i < p->n; i++)
+            solid += p->kind[i] != MF_FLUID;
+        double obst_max[3];
+        memcpy(obst_max, s.obst_max, sizeof obst_max);
+        if (solid > 0)
+            mf_box_lattice_max(snap.l0, snap.dim, s.obst_min, obst_max);
         for (size_t i = 0; i < p->n; i++) {
             if (p->kind[i] != MF_FLUID)
                 continue;
             const double *x = &p->pos[3 * i];
             n++;
             outside += !in_box(x, s.tank_min, s.tank_max, h, snap.dim);
-            inside += obstacle && in_box(x, s.obst_min, s.obst_max, -h, snap.dim);
+            inside += obstacle && in_box(x, s.obst_min, obst_max, -h, snap.dim);
         }
         col[0][k] = snap.time;
         col[1][k] = (double)n;
