@@ -7,9 +7,10 @@
  * follows the particles, not the bounding box (an L-shaped corridor does not
  * pay for the empty corner).
  *
- * A neighbour list holds, for each particle i in [0, n), the indices j != i
- * with |r_j - r_i| < radius, in CSR form, radius up to grid.reach cell
- * sizes. The j's of each i come in the grid's order: ascending (cell key of
+ * A neighbour list holds, for each owned particle i in [0, n_owned), the
+ * indices j != i in [0, n) with |r_j - r_i| < radius, in CSR form, radius
+ * up to grid.reach cell sizes; the rows of the copies [n_owned, n) (other
+ * ranks' particles, periodic images) are empty, as no loop visits them. The j's of each i come in the grid's order: ascending (cell key of
  * j, j), the key of a cell of side cell_size with the origin at the lower
  * corner of the particles' bounding box. Every sum over a list therefore runs
  * in an order fixed by the positions and the cell size alone, whichever way

@@ -21,6 +21,15 @@
  * cell order, that is ascending (cell key, index), the same for any thread
  * count. When the bits would take too much memory (cells much larger than
  * the radius) the fill pass repeats the distance test instead.
+ *
+ * Only the owned particles [0, n_owned) get lists: the copies of other
+ * ranks' particles and the periodic images [n_owned, n) are binned and
+ * found as j's, but their rows are empty (the pair engine's i-loops cover
+ * the owned particles only, mf_pairs.h), and they take no part in the
+ * choice of a cell's candidate rows, which are the union over the cell's
+ * owned particles (a candidate row more or less changes no list: the
+ * distance test decides). Without copies (a serial run without periodic
+ * images) n_owned = n: nothing changes.
  */
 #include "neighbours_internal.h"
 #include "mf_alloc.h"
@@ -372,11 +381,13 @@ static inline void axis_span(double x, double origin, double inv_width, double r
  * ascending, so that hits come in key order. With R up to the cell size that
  * is the 3^dim block around it, as a single-reach grid always used. */
 KERNEL int cell_rows(const mf_grid *g, const cell_bounds *cb, size_t c, const pair_test *t,
-                     double radius, double inv_width, int dim, uint32_t *rows)
+                     double radius, double inv_width, int dim, size_t ni, uint32_t *rows)
 {
     const int reach = g->reach, w = 2 * reach + 1;
     int xl = 0, xh = 0, yl = 0, yh = 0, zl = 0, zh = 0;
     for (size_t k = g->cell_start[c]; k < g->cell_start[c + 1]; k++) {
+        if (g->order[k] >= ni) /* a copy: no list of its own (see the top) */
+            continue;
         int lo, hi;
         axis_span(t->sx[k], g->origin[0], inv_width, radius, cb->ix, reach, &lo, &hi);
         xl = lo < xl ? lo : xl;
@@ -411,6 +422,7 @@ typedef struct {
     const mf_grid *g;
     pair_test t;
     double radius, inv_width;
+    size_t ni;               /* lists for particles [0, ni): the owned ones */
     int nrows;               /* rows stored per cell */
     size_t *cell_word;       /* ncells + 1 word offsets, or NULL: no bits */
     uint64_t *bits;
@@ -429,7 +441,7 @@ KERNEL int rows_of(const list_build *lb, size_t c, int dim, uint32_t *rows, size
 {
     cell_bounds cb;
     bounds_of_cell(lb->g, c, lb->nrows, &cb);
-    int n = cell_rows(lb->g, &cb, c, &lb->t, lb->radius, lb->inv_width, dim, rows);
+    int n = cell_rows(lb->g, &cb, c, &lb->t, lb->radius, lb->inv_width, dim, lb->ni, rows);
     *nwords = words_per_particle(rows, n);
     return n;
 }
@@ -454,6 +466,12 @@ KERNEL void count_cell(const list_build *lb, size_t c, int dim, bool keep_bits, 
     const int n = rows_of(lb, c, dim, rows, &nw);
     const size_t k0 = g->cell_start[c];
     for (size_t k = k0; k < g->cell_start[c + 1]; k++) {
+        if (g->order[k] >= lb->ni) { /* a copy: an empty row */
+            start[g->order[k] + 1] = 0;
+            if (sub)
+                sstart[g->order[k] + 1] = 0;
+            continue;
+        }
         double xi[3];
         load_position(&lb->t, k, xi);
         size_t shits = 0;
@@ -480,9 +498,11 @@ KERNEL void fill_cell(const list_build *lb, size_t c, int dim, const uint32_t *s
     row_bit_offsets(rows, n, row_bit);
     const size_t k0 = g->cell_start[c];
     for (size_t k = k0; k < g->cell_start[c + 1]; k++) {
+        const uint32_t i = g->order[k];
+        if (i >= lb->ni) /* a copy: an empty row */
+            continue;
         double xi[3];
         load_position(&lb->t, k, xi);
-        const uint32_t i = g->order[k];
         uint32_t *out = jlist + start[i];
         if (lb->cell_word) {
             const uint64_t *words = lb->bits + lb->cell_word[c] + (k - k0) * nw;
@@ -639,6 +659,7 @@ int mf_nlist_build_pair(mf_nlist *nl, mf_nlist *sub, const mf_grid *g, const mf_
         .t = {g->spos, g->spos + n, g->spos + 2 * n, radius * radius,
               sub ? sub_radius * sub_radius : 0.0},
         .radius = radius,
+        .ni = p->n_owned < n ? p->n_owned : n,
         .inv_width = 1.0 / binning_width(g->cell_size),
         .nrows = rows_per_cell(g->dim, g->reach),
     };
