@@ -10,8 +10,9 @@
  * A neighbour list holds, for each owned particle i in [0, n_owned), the
  * indices j != i in [0, n) with |r_j - r_i| < radius, in CSR form, radius
  * up to grid.reach cell sizes; the rows of the copies [n_owned, n) (other
- * ranks' particles, periodic images) are empty, as no loop visits them. The j's of each i come in the grid's order: ascending (cell key of
- * j, j), the key of a cell of side cell_size with the origin at the lower
+ * ranks' particles, periodic images) are empty, as no loop visits them.
+ * The j's of each i come in the grid's order: ascending (cell key of j,
+ * j), the key of a cell of side cell_size with the origin at the lower
  * corner of the particles' bounding box. Every sum over a list therefore runs
  * in an order fixed by the positions and the cell size alone, whichever way
  * the list was made (built, or kept and re-sorted: mf_nlist_sort).
@@ -174,7 +175,7 @@ size_t mf_neighbours_memory(const mf_neighbours *nb);
 typedef struct mf_neighbours_stats {
     long builds, sorts, checks;
     double seconds;        /* in builds, sorts and checks */
-    double entries;        /* list entries per particle of the last build (largest cell) */
+    double entries;        /* list entries per owned particle of the last build (largest cell) */
 } mf_neighbours_stats;
 void mf_neighbours_get_stats(const mf_neighbours *nb, mf_neighbours_stats *out);
 

@@ -282,7 +282,8 @@ static int build(mf_neighbours *nb, nb_class *c, const mf_particles *p)
     c->d_first = -1;
     c->epoch = nb->epoch;
     nb->stats.builds++;
-    nb->stats.entries = np ? (double)c->list.start[np] / (double)np : 0.0;
+    /* Per owned particle: the copies' rows are empty (nlist.c). */
+    nb->stats.entries = p->n_owned ? (double)c->list.start[np] / (double)p->n_owned : 0.0;
     return 0;
 }
 
