@@ -537,11 +537,17 @@ static bool same_lists(const mf_nlist *a, const mf_nlist *b)
  * way: mf_grid_cells at the build, mf_nlist_mark_moved, mf_nlist_sort_marked)
  * is the list sorted in full, after random moves that take some particles
  * into other cells, over three rounds (the cells of a round from its keys),
- * for the list and the sub-list of the same build, in 2-D and 3-D. */
+ * for the list and the sub-list of the same build, in 2-D and 3-D; and with
+ * the last quarter of the particles copies (a halo: empty rows of their
+ * own, found only as j's). */
 static void test_sort_moved(void)
 {
-    for (int dim = 2; dim <= 3; dim++) {
+    for (int run = 0; run < 4; run++) {
+        const int dim = 2 + run % 2;
+        const bool copies = run >= 2;
         mf_particles *p = random_points(dim, dim == 2 ? 3000 : 4000, 2.0);
+        if (copies)
+            p->n_owned = p->n - p->n / 4;
         const double cell = dim == 2 ? 0.1 : 0.25;
         mf_grid g;
         mf_nlist nl, sub;
@@ -571,7 +577,7 @@ static void test_sort_moved(void)
             copy_list(&fsub, &sub);
             mf_nlist_sort(&full, keys, packed);
             mf_nlist_sort(&fsub, keys, packed);
-            mf_nlist_mark_moved(&nl, keys, cell0, dirty);
+            mf_nlist_mark_moved(&nl, keys, cell0, p->n_owned, dirty);
             for (size_t i = 0; i < p->n; i++)
                 marked += dirty[i];
             mf_nlist_sort_marked(&nl, keys, packed, dirty);
@@ -580,7 +586,8 @@ static void test_sort_moved(void)
             CHECK_MSG(moved > 0 && marked < p->n, "%d-D round %d: %zu moved, %zu of %zu marked",
                       dim, round, moved, marked, p->n);
             CHECK_MSG(same_lists(&nl, &full) && same_lists(&sub, &fsub),
-                      "%d-D round %d: the marked sort differs from the full sort", dim, round);
+                      "%d-D round %d%s: the marked sort differs from the full sort", dim, round,
+                      copies ? " (with copies)" : "");
             reordered += !same_lists(&orig, &full); /* the sorts had work to do */
             mf_nlist_free(&orig);
             for (size_t i = 0; i < p->n; i++)
@@ -588,8 +595,8 @@ static void test_sort_moved(void)
             mf_nlist_free(&full);
             mf_nlist_free(&fsub);
         }
-        CHECK_MSG(reordered == 3, "%d-D: the moves reordered the lists in %d of 3 rounds", dim,
-                  reordered);
+        CHECK_MSG(reordered == 3, "%d-D%s: the moves reordered the lists in %d of 3 rounds", dim,
+                  copies ? " (with copies)" : "", reordered);
         free(cell0);
         free(keys);
         free(dirty);

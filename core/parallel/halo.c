@@ -201,11 +201,14 @@ static void owned_box(const mf_particles *p, double box[6])
         box[c] = INFINITY;
         box[3 + c] = -INFINITY;
     }
+    /* Comparisons, not fmin/fmax: the same box (a NaN is passed over either
+     * way; a -0 against a +0 decides no box test), without a libm call per
+     * coordinate (two a particle and axis, at every halo build). */
     for (size_t i = 0; i < p->n_owned; i++)
         for (int c = 0; c < 3; c++) {
             const double v = p->pos[3 * i + c];
-            box[c] = fmin(box[c], v);
-            box[3 + c] = fmax(box[3 + c], v);
+            box[c] = v < box[c] ? v : box[c];
+            box[3 + c] = v > box[3 + c] ? v : box[3 + c];
         }
 }
 

@@ -7,10 +7,12 @@
  * follows the particles, not the bounding box (an L-shaped corridor does not
  * pay for the empty corner).
  *
- * A neighbour list holds, for each particle i in [0, n), the indices j != i
- * with |r_j - r_i| < radius, in CSR form, radius up to grid.reach cell
- * sizes. The j's of each i come in the grid's order: ascending (cell key of
- * j, j), the key of a cell of side cell_size with the origin at the lower
+ * A neighbour list holds, for each owned particle i in [0, n_owned), the
+ * indices j != i in [0, n) with |r_j - r_i| < radius, in CSR form, radius
+ * up to grid.reach cell sizes; the rows of the copies [n_owned, n) (other
+ * ranks' particles, periodic images) are empty, as no loop visits them.
+ * The j's of each i come in the grid's order: ascending (cell key of j,
+ * j), the key of a cell of side cell_size with the origin at the lower
  * corner of the particles' bounding box. Every sum over a list therefore runs
  * in an order fixed by the positions and the cell size alone, whichever way
  * the list was made (built, or kept and re-sorted: mf_nlist_sort).
@@ -136,9 +138,12 @@ void mf_nlist_sort(mf_nlist *nl, const uint64_t *keys, bool packed);
  * sort_marked sorts the marked lists only, which gives mf_nlist_sort's
  * result (the unmarked ones are in order already). A sub-list made in the
  * same build (mf_nlist_build_pair) holds a subset of each list: the
- * list's marks serve it. */
+ * list's marks serve it. Particles [n_rows, nl->n) (the copies of other
+ * ranks' particles and the periodic images) have empty rows, so their own
+ * lists cannot say who holds them: for a copy that changed cell, the lists
+ * of [0, n_rows) are searched for it instead. */
 void mf_nlist_mark_moved(const mf_nlist *nl, const uint64_t *keys, const uint32_t *cell_before,
-                         uint8_t *dirty);
+                         size_t n_rows, uint8_t *dirty);
 void mf_nlist_sort_marked(mf_nlist *nl, const uint64_t *keys, bool packed,
                           const uint8_t *dirty);
 size_t mf_nlist_memory(const mf_nlist *nl);
@@ -191,7 +196,7 @@ size_t mf_neighbours_memory(const mf_neighbours *nb);
 typedef struct mf_neighbours_stats {
     long builds, sorts, checks;
     double seconds;        /* in builds, sorts and checks */
-    double entries;        /* list entries per particle of the last build (largest cell) */
+    double entries;        /* list entries per owned particle of the last build (largest cell) */
 } mf_neighbours_stats;
 void mf_neighbours_get_stats(const mf_neighbours *nb, mf_neighbours_stats *out);
 

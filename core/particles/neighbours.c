@@ -303,7 +303,8 @@ static int build(mf_neighbours *nb, nb_class *c, const mf_particles *p)
     c->d_first = -1;
     c->epoch = nb->epoch;
     nb->stats.builds++;
-    nb->stats.entries = np ? (double)c->list.start[np] / (double)np : 0.0;
+    /* Per owned particle: the copies' rows are empty (nlist.c). */
+    nb->stats.entries = p->n_owned ? (double)c->list.start[np] / (double)p->n_owned : 0.0;
     return 0;
 }
 
@@ -335,7 +336,7 @@ static int order_lists(nb_class *c, const uint64_t *keys, bool packed)
     if (c->cells_known == CELLS_KEPT && !dirty)
         return MF_ERROR(MF_ERR_MEMORY, "out of memory for %zu list marks", n);
     if (dirty) {
-        mf_nlist_mark_moved(&c->list, keys, c->cell0, dirty);
+        mf_nlist_mark_moved(&c->list, keys, c->cell0, c->store ? c->store->n_owned : n, dirty);
         mf_nlist_sort_marked(&c->list, keys, true, dirty);
         if (c->sub_radius > 0)
             mf_nlist_sort_marked(&c->sub, keys, true, dirty);

@@ -21,6 +21,15 @@
  * cell order, that is ascending (cell key, index), the same for any thread
  * count. When the bits would take too much memory (cells much larger than
  * the radius) the fill pass repeats the distance test instead.
+ *
+ * Only the owned particles [0, n_owned) get lists: the copies of other
+ * ranks' particles and the periodic images [n_owned, n) are binned and
+ * found as j's, but their rows are empty (the pair engine's i-loops cover
+ * the owned particles only, mf_pairs.h), and they take no part in the
+ * choice of a cell's candidate rows, which are the union over the cell's
+ * owned particles (a candidate row more or less changes no list: the
+ * distance test decides). Without copies (a serial run without periodic
+ * images) n_owned = n: nothing changes.
  */
 #include "neighbours_internal.h"
 #include "mf_alloc.h"
@@ -374,11 +383,13 @@ static inline void axis_span(double x, double origin, double inv_width, double r
  * ascending, so that hits come in key order. With R up to the cell size that
  * is the 3^dim block around it, as a single-reach grid always used. */
 KERNEL int cell_rows(const mf_grid *g, const cell_bounds *cb, size_t c, const pair_test *t,
-                     double radius, double inv_width, int dim, uint32_t *rows)
+                     double radius, double inv_width, int dim, size_t ni, uint32_t *rows)
 {
     const int reach = g->reach, w = 2 * reach + 1;
     int xl = 0, xh = 0, yl = 0, yh = 0, zl = 0, zh = 0;
     for (size_t k = g->cell_start[c]; k < g->cell_start[c + 1]; k++) {
+        if (g->order[k] >= ni) /* a copy: no list of its own (see the top) */
+            continue;
         int lo, hi;
         axis_span(t->sx[k], g->origin[0], inv_width, radius, cb->ix, reach, &lo, &hi);
         xl = lo < xl ? lo : xl;
@@ -413,6 +424,7 @@ typedef struct {
     const mf_grid *g;
     pair_test t;
     double radius, inv_width;
+    size_t ni;               /* lists for particles [0, ni): the owned ones */
     int nrows;               /* rows stored per cell */
     size_t *cell_word;       /* ncells + 1 word offsets, or NULL: no bits */
     uint64_t *bits;
@@ -448,7 +460,7 @@ KERNEL void plan_cell(const list_build *lb, size_t c, int dim)
     cell_bounds cb;
     bounds_of_cell(lb->g, c, lb->nrows, &cb);
     uint32_t *r = lb->cell_ranges + c * lb->range_slots;
-    const int n = cell_rows(lb->g, &cb, c, &lb->t, lb->radius, lb->inv_width, dim, r + 1);
+    const int n = cell_rows(lb->g, &cb, c, &lb->t, lb->radius, lb->inv_width, dim, lb->ni, r + 1);
     r[0] = (uint32_t)n;
     lb->cell_word[c + 1] =
         words_per_particle(r + 1, n) * (lb->g->cell_start[c + 1] - lb->g->cell_start[c]);
@@ -465,6 +477,12 @@ KERNEL void count_cell(const list_build *lb, size_t c, int dim, bool keep_bits, 
     const int n = rows_of(lb, c, &rows, &nw);
     const size_t k0 = g->cell_start[c];
     for (size_t k = k0; k < g->cell_start[c + 1]; k++) {
+        if (g->order[k] >= lb->ni) { /* a copy: an empty row */
+            start[g->order[k] + 1] = 0;
+            if (sub)
+                sstart[g->order[k] + 1] = 0;
+            continue;
+        }
         double xi[3];
         load_position(&lb->t, k, xi);
         size_t shits = 0;
@@ -499,9 +517,11 @@ KERNEL void fill_cell(const list_build *lb, size_t c, int dim, const uint32_t *s
             own_bit = row_bit[r] - (size_t)rows[2 * r];
     }
     for (size_t k = k0; k < g->cell_start[c + 1]; k++) {
+        const uint32_t i = g->order[k];
+        if (i >= lb->ni) /* a copy: an empty row */
+            continue;
         double xi[3];
         load_position(&lb->t, k, xi);
-        const uint32_t i = g->order[k];
         uint32_t *out = jlist + start[i];
         if (lb->cell_word) {
             uint64_t *words = lb->bits + lb->cell_word[c] + (k - k0) * nw;
@@ -666,6 +686,7 @@ int mf_nlist_build_pair(mf_nlist *nl, mf_nlist *sub, const mf_grid *g, const mf_
         .t = {g->spos, g->spos + n, g->spos + 2 * n, radius * radius,
               sub ? sub_radius * sub_radius : 0.0},
         .radius = radius,
+        .ni = p->n_owned < n ? p->n_owned : n,
         .inv_width = 1.0 / binning_width(g->cell_size),
         .nrows = rows_per_cell(g->dim, g->reach),
     };
@@ -733,16 +754,31 @@ void mf_nlist_sort(mf_nlist *nl, const uint64_t *keys, bool packed)
 
 /* The lists that hold a particle whose cell changed: by symmetry, those of
  * the moved particles' own neighbours. */
+static inline bool changed_cell(const uint64_t *keys, const uint32_t *cell_before, size_t j)
+{
+    return (uint32_t)(keys[j] >> 32) != cell_before[j];
+}
+
 void mf_nlist_mark_moved(const mf_nlist *nl, const uint64_t *keys, const uint32_t *cell_before,
-                         uint8_t *dirty)
+                         size_t n_rows, uint8_t *dirty)
 {
     const size_t n = nl->n;
     const uint32_t *start = nl->start, *jl = nl->j;
+    if (n_rows > n)
+        n_rows = n;
     memset(dirty, 0, n);
-    for (size_t j = 0; j < n; j++) /* serial: a few particles change cell a step */
-        if ((uint32_t)(keys[j] >> 32) != cell_before[j])
+    for (size_t j = 0; j < n_rows; j++) /* serial: a few particles change cell a step */
+        if (changed_cell(keys, cell_before, j))
             for (uint32_t e = start[j]; e < start[j + 1]; e++)
                 dirty[jl[e]] = 1;
+    bool copy_moved = false; /* a copy's row is empty: who holds it is not known */
+    for (size_t j = n_rows; j < n && !copy_moved; j++)
+        copy_moved = changed_cell(keys, cell_before, j);
+    if (!copy_moved)
+        return;
+    for (size_t i = 0; i < n_rows; i++)
+        for (uint32_t e = start[i]; !dirty[i] && e < start[i + 1]; e++)
+            dirty[i] = jl[e] >= n_rows && changed_cell(keys, cell_before, jl[e]);
 }
 
 /* Only a marked list can be out of order: the others hold only particles

@@ -69,6 +69,20 @@ static int split_reserve(mf_split_csr *s, size_t n, size_t nnz)
     return 0;
 }
 
+int mf_split_csr_reserve(mf_split_csr *s, size_t n, size_t nnz)
+{
+    if (n > INT32_MAX || nnz > INT32_MAX)
+        return MF_ERROR(MF_ERR_INPUT, "a matrix of %zu rows and %zu non-zeros is too large for "
+                        "32-bit indices", n, nnz);
+    MF_CALL(split_reserve(s, n, nnz));
+    s->col = s->col_buf;
+    s->val = s->val_buf;
+    s->gap = 0;
+    s->lent = NULL;
+    s->n = (int32_t)n;
+    return 0;
+}
+
 int mf_split_csr_set(mf_split_csr *s, const mf_csr *A)
 {
     const size_t n = A->nrows;

@@ -76,6 +76,11 @@ static inline int32_t mf_split_end(const mf_split_csr *s, int32_t i)
  * anywhere in its row, duplicates summed into it) into the split layout,
  * growing s's arrays as needed. */
 int mf_split_csr_set(mf_split_csr *s, const mf_csr *A);
+/* s as an empty copy of n rows with room for nnz off-diagonal entries, for
+ * a caller that writes the split layout itself (ptr, mid, diag, dinv, and
+ * the entries at col_buf, val_buf), as mf_split_csr_set would have: s->n
+ * = n on return. */
+int mf_split_csr_reserve(mf_split_csr *s, size_t n, size_t nnz);
 /* The same layout without a copy when every row of A starts with its
  * diagonal (and has it once): when the rows are already split (lower
  * columns, then upper ones) s reads A's col and val; when A lends them

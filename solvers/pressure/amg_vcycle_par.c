@@ -493,18 +493,17 @@ static int build_rows_block(par_block *F, const mf_csr *A, const mf_par_slots *p
     int32_t *row_of = malloc(((size_t)n + 1) * sizeof *row_of);
     int *loc = malloc(((size_t)total + 1) * sizeof *loc);
     int *cmap = malloc((nnz + 1) * sizeof *cmap);
-    size_t *rp = malloc(((size_t)n + 1) * sizeof *rp);
-    int32_t *dcol = malloc((nnz + (size_t)n + 1) * sizeof *dcol);
-    double *dval = malloc((nnz + (size_t)n + 1) * sizeof *dval);
     F->own_oi = malloc(((size_t)n + 1) * sizeof *F->own_oi);
     F->own_oj = malloc((nnz + 1) * sizeof *F->own_oj);
     F->own_ov = malloc((nnz + 1) * sizeof *F->own_ov);
     int *need = calloc((size_t)nprocs, sizeof *need), *give = calloc((size_t)nprocs, sizeof *give);
     int *nd = calloc((size_t)nprocs, sizeof *nd), *gd = calloc((size_t)nprocs, sizeof *gd);
     int *req = NULL;
-    if (!row_of || !loc || !cmap || !rp || !dcol || !dval || !F->own_oi || !F->own_oj ||
-        !F->own_ov || !need || !give || !nd || !gd)
+    if (!row_of || !loc || !cmap || !F->own_oi || !F->own_oj || !F->own_ov || !need || !give ||
+        !nd || !gd)
         rc = MF_ERROR(MF_ERR_MEMORY, "out of memory for the fine level (%d slots)", n);
+    if (rc == 0)
+        rc = mf_split_csr_reserve(&F->D, (size_t)n, nnz);
     MF_CALL_GOTO(rc, mf_hypre_agree("PCG_BoomerAMG", rc), out);
 
     /* The other ranks' slots read, once each (loc marks them), then in
@@ -533,33 +532,49 @@ static int build_rows_block(par_block *F, const mf_csr *A, const mf_par_slots *p
         loc[cmap[j]] = j;
     const double dfree = nrows > 0 && dsum > 0 ? dsum / nrows : 1.0;
 
-    /* The rows by slot: diag block (local columns) and offd block. */
-    size_t kd = 0;
-    int32_t ko = 0;
+    /* The rows by slot: the diag block (local columns) straight into the
+     * split layout, in one pass over the row for the lower part, the
+     * diagonal and the offd block, one more for the upper part: the layout
+     * and the bits mf_split_csr_set makes of the diag block's CSR. */
+    mf_split_csr *S = &F->D;
+    int32_t kd = 0, ko = 0;
+    S->ptr[0] = 0;
     for (int32_t s = 0; s < n; s++) {
-        rp[s] = kd;
         F->own_oi[s] = ko;
         const int32_t r = row_of[s];
-        if (r < 0) {
-            dcol[kd] = s;
-            dval[kd++] = dfree;
-            continue;
-        }
-        for (size_t k = A->rowptr[r]; k < A->rowptr[r + 1]; k++) {
-            const int g = ps->of_row[A->col[k]];
-            if (g >= first && g < first + n) {
-                dcol[kd] = g - first;
-                dval[kd++] = A->val[k];
-            } else {
-                F->own_oj[ko] = loc[g];
-                F->own_ov[ko++] = A->val[k];
+        double d = 0.0;
+        if (r < 0)
+            d += dfree;
+        else {
+            for (size_t k = A->rowptr[r]; k < A->rowptr[r + 1]; k++) {
+                const int g = ps->of_row[A->col[k]];
+                if (g >= first && g < first + n) {
+                    const int32_t c = g - first;
+                    if (c == s)
+                        d += A->val[k];
+                    else if (c < s) {
+                        S->col_buf[kd] = c;
+                        S->val_buf[kd++] = A->val[k];
+                    }
+                } else {
+                    F->own_oj[ko] = loc[g];
+                    F->own_ov[ko++] = A->val[k];
+                }
             }
         }
+        S->mid[s] = kd;
+        for (size_t k = r < 0 ? 0 : A->rowptr[r]; r >= 0 && k < A->rowptr[r + 1]; k++) {
+            const int g = ps->of_row[A->col[k]];
+            if (g > first + s && g < first + n) {
+                S->col_buf[kd] = g - first;
+                S->val_buf[kd++] = A->val[k];
+            }
+        }
+        S->ptr[s + 1] = kd;
+        S->diag[s] = d;
+        S->dinv[s] = d != 0.0 ? 1.0 / d : 0.0;
     }
-    rp[n] = kd;
     F->own_oi[n] = ko;
-    const mf_csr D = {.nrows = (size_t)n, .nglobal = n, .rowptr = rp, .col = dcol, .val = dval};
-    MF_CALL_GOTO(rc, mf_split_csr_set(&F->D, &D), agree);
     F->n = n;
     F->ncols_offd = ncm;
     F->oi = ko > 0 ? F->own_oi : NULL;
@@ -621,15 +636,11 @@ static int build_rows_block(par_block *F, const mf_csr *A, const mf_par_slots *p
         hypre_TFree(send_starts, HYPRE_MEMORY_HOST);
         hypre_TFree(send_elmts, HYPRE_MEMORY_HOST);
     }
-agree:
     rc = mf_hypre_agree("PCG_BoomerAMG", rc);
 out:
     free(row_of);
     free(loc);
     free(cmap);
-    free(rp);
-    free(dcol);
-    free(dval);
     free(need);
     free(give);
     free(nd);

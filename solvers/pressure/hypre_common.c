@@ -870,6 +870,11 @@ int mf_hypre_pcg_solve(const mf_hypre_pcg *pcg, const mf_csr *A, const double *b
         MF_CALL_GOTO(rc, par_rows_solve(who, pcg, &pc, A, &ss, b, x, bnorm, rep, t_start,
                                         &t_solve, &ran),
                      done);
+    /* Our PCG over the caller's rows has the honest number already: its last
+     * residual is the true ||b - A x|| of those rows (build_rows_block in
+     * amg_vcycle_par.c copies them, no hypre assembly in between), as the
+     * serial mf_amg_pcg's is of residual_local. */
+    const bool rows_residual = ran;
     if (!ran) {
         MF_CALL_GOTO(rc, assemble(who, A, &ss, b, x, &sys), done);
         if (lay.nprocs > 1 && pc.par != NULL)
@@ -885,8 +890,10 @@ int mf_hypre_pcg_solve(const mf_hypre_pcg *pcg, const mf_csr *A, const double *b
     }
 
     /* The honest number: ||b - A x|| / ||b|| from the caller's matrix. */
-    MF_CALL_GOTO(rc, residual_norm(who, A, b, x, &lay, &rnorm), done);
-    rep->final_residual = rnorm / bnorm;
+    if (!rows_residual) {
+        MF_CALL_GOTO(rc, residual_norm(who, A, b, x, &lay, &rnorm), done);
+        rep->final_residual = rnorm / bnorm;
+    }
     converged = rep->final_residual <= pcg->tolerance; /* false for NaN */
     rep->converged = converged;
     rep->solve_seconds = MPI_Wtime() - t_solve;
