@@ -332,7 +332,7 @@ static double surface_energy(const mf_sim *sim)
     return sigma * (sim->dim == 3 ? 2 * (a * b + b * c + a * c) : 2 * (a + b));
 }
 
-/* The fastest fluid particle, for the messages. */
+/* The fastest fluid particle of this rank. */
 static size_t fastest_fluid(const mf_sim *sim, double *speed)
 {
     const mf_particles *p = sim->p;
@@ -350,6 +350,15 @@ static size_t fastest_fluid(const mf_sim *sim, double *speed)
     }
     *speed = sqrt(fmax(u2max, 0));
     return best;
+}
+
+/* The fastest fluid particle over the ranks, for the messages (collective). */
+static double fastest_over_ranks(const mf_sim *sim, mf_particle_info *f)
+{
+    double speed = 0;
+    const size_t i = fastest_fluid(sim, &speed);
+    mf_parallel_argmax(sim->par, &speed, sim->p, i, f);
+    return speed;
 }
 
 /* The kinetic energy the fluid would have moving as fast as the fastest
@@ -405,10 +414,8 @@ static int check_energy(mf_watch *w, const mf_sim *sim, double dt, double *ke_ou
     w->next_time = sim->time;
     if (!(scale > 0 && excess > w->s.energy_tolerance * scale))
         return 0;
-    double speed = 0;
-    const size_t i = fastest_fluid(sim, &speed);
-    mf_particle_info f; /* the fastest over the ranks */
-    mf_parallel_argmax(sim->par, &speed, sim->p, i, &f);
+    mf_particle_info f;
+    const double speed = fastest_over_ranks(sim, &f);
     const double *x = f.x;
     return MF_ERROR(MF_ERR_NUMERIC,
                     "unstable (energy) at time %g, step %ld: the fluid's kinetic energy %g J "
@@ -486,10 +493,8 @@ static int check_available(mf_watch *w, const mf_sim *sim, double dt, double ke,
     w->next_time = sim->time;
     if (!(excess > w->s.available_tolerance * scale))
         return 0;
-    double speed = 0;
-    const size_t i = fastest_fluid(sim, &speed);
-    mf_particle_info f; /* the fastest over the ranks */
-    mf_parallel_argmax(sim->par, &speed, sim->p, i, &f);
+    mf_particle_info f;
+    const double speed = fastest_over_ranks(sim, &f);
     const double *x = f.x;
     return MF_ERROR(MF_ERR_NUMERIC,
                     "unstable (availableEnergy) at time %g, step %ld: the fluid's kinetic energy "

@@ -19,10 +19,6 @@
 #include "mf_error.h"
 #include "row_dot.h"
 
-/* LAPACK (Fortran interface): LU with partial pivoting of the coarsest level. */
-extern void dgetrf_(const int *m, const int *n, double *a, const int *lda, int *ipiv, int *info);
-extern void dgetrs_(const char *trans, const int *n, const int *nrhs, const double *a,
-                    const int *lda, const int *ipiv, double *b, const int *ldb, int *info);
 
 /* ---- the split matrix -------------------------------------------------- */
 

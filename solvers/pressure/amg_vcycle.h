@@ -37,6 +37,12 @@
 #include <stdint.h>
 
 #include "mf_modules.h"
+
+/* LAPACK (Fortran interface): LU with partial pivoting of the coarsest
+ * level, on one rank and (the same matrix on every rank) on N. */
+extern void dgetrf_(const int *m, const int *n, double *a, const int *lda, int *ipiv, int *info);
+extern void dgetrs_(const char *trans, const int *n, const int *nrhs, const double *a,
+                    const int *lda, const int *ipiv, double *b, const int *ldb, int *info);
 #include "row_dot.h"
 
 /* A square matrix by rows, the diagonal apart: the off-diagonal entries of
