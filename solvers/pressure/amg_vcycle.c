@@ -19,7 +19,6 @@
 #include "mf_error.h"
 #include "row_dot.h"
 
-
 /* ---- the split matrix -------------------------------------------------- */
 
 /* Columns and values with room for need + 1 entries: grown when *cap is
