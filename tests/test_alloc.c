@@ -106,13 +106,25 @@ static void test_release_pages(void)
     CHECK(mf_release_pages(NULL, (size_t)1 << 30) == 0);
 }
 
+/* The blocks go through this: a compiler may otherwise drop a malloc,
+ * memset and free whose memory nobody reads (clang does), and there would
+ * be nothing to measure. */
+static void *volatile sink;
+
+static void *kept_malloc(size_t bytes)
+{
+    void *b = malloc(bytes);
+    sink = b;
+    return sink;
+}
+
 /* A 32 MiB block: is it mmapped (mallinfo2's hblkhd), and how much of it
  * stays resident once freed? */
 static void large_block(size_t *mapped, size_t *kept)
 {
     const size_t bytes = (size_t)32 << 20;
     const size_t base = resident_bytes();
-    char *b = malloc(bytes);
+    char *b = kept_malloc(bytes);
     CHECK(b != NULL);
     if (!b)
         return;
@@ -130,7 +142,7 @@ static size_t small_blocks_kept(void)
     static char *b[count];
     const size_t base = resident_bytes();
     for (int k = 0; k < count; k++) {
-        b[k] = malloc(64 * 1024);
+        b[k] = kept_malloc(64 * 1024);
         if (b[k])
             memset(b[k], 1, 64 * 1024);
     }

@@ -201,10 +201,24 @@ static void test_tables(void)
         defaults(all[m], settings);
         for (size_t i = 0; i < info->nparams; i++) {
             const mf_param *par = &info->params[i];
-            double v = par->type == MF_PARAM_SCALAR ? *(double *)(settings + par->offset)
-                                                    : (double)*(long *)(settings + par->offset);
-            CHECK_MSG(par->min > par->max || (v >= par->min && v <= par->max), "%s.%s = %g",
-                      info->name, par->name, v);
+            /* each field read as its own type: a bool is one byte, anywhere */
+            double v = 0;
+            bool ranged = true;
+            if (par->type == MF_PARAM_SCALAR) {
+                memcpy(&v, settings + par->offset, sizeof v);
+            } else if (par->type == MF_PARAM_INT) {
+                long l;
+                memcpy(&l, settings + par->offset, sizeof l);
+                v = (double)l;
+            } else if (par->type == MF_PARAM_BOOL) {
+                bool b;
+                memcpy(&b, settings + par->offset, sizeof b);
+                v = b;
+            } else {
+                ranged = false; /* words, vectors, dictionaries: no range */
+            }
+            CHECK_MSG(!ranged || par->min > par->max || (v >= par->min && v <= par->max),
+                      "%s.%s = %g", info->name, par->name, v);
             CHECK_MSG(par->doc && par->doc[0], "%s.%s has no doc", info->name, par->name);
         }
         void *data = NULL;
