@@ -1,6 +1,7 @@
 /* run.c: the time loop. */
 #include "mf_run.h"
 #include "mf_run_internal.h"
+#include "mf_thread_tuner.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -376,6 +377,8 @@ int mf_run_loop(mf_run *run, bool write_initial)
     saved_state saved;
     memset(&saved, 0, sizeof saved);
     const double t0 = mf_wall_seconds(), c0 = mf_cpu_seconds();
+    mf_thread_tuner tuner; /* the team size, by measurement (mf_thread_tuner.h) */
+    mf_thread_tuner_init(&tuner, false, 1);
     /* Next write time: the first multiple of the interval after now. */
     double next_write = mf_run_first_write(run);
     int rc = 0;
@@ -410,8 +413,14 @@ int mf_run_loop(mf_run *run, bool write_initial)
     if (write_initial)
         MF_CALL_GOTO(rc, write_now(run), done);
     mf_log_printf(sim->log, MF_LOG_NORMAL, "\nStarting time loop\n\n");
+    mf_thread_tuner_start(&tuner);
     while (sim->time < sim->end_time * (1 - 1e-12)) {
+        const double step_start = mf_wall_seconds();
         rc = step_once(run, &saved, next_write);
+        if (rc == 0) { /* the write below is not the step's time: timed before it */
+            mf_thread_tuner_next(&tuner, mf_wall_seconds() - step_start, true);
+            mf_thread_tuner_apply(&tuner);
+        }
         if (rc != 0) {
             /* Keep what we had: the state before the failed step. */
             mf_log_printf(sim->log, MF_LOG_QUIET,
@@ -448,6 +457,15 @@ int mf_run_loop(mf_run *run, bool write_initial)
     }
     mf_log_progress_end(sim->log);
 done:
+    if (tuner.on) {
+        mf_log_printf(sim->log, MF_LOG_NORMAL,
+                      "Threads: chosen by measurement (OMP_NUM_THREADS not set): %ld steps with "
+                      "%d threads, %ld with 1; one thread was the faster in %d of %d probes\n",
+                      tuner.steps_with[0], tuner.full, tuner.steps_with[1], tuner.chose_one,
+                      tuner.probes);
+        tuner.current = tuner.full; /* what comes after the run has the whole team */
+        mf_thread_tuner_apply(&tuner);
+    }
     if (sim->emitters)
         mf_log_printf(sim->log, MF_LOG_QUIET, "Emitters over the run: added %zu, removed %zu\n",
                       sim->emitters->total_added, sim->emitters->total_removed);
