@@ -651,11 +651,8 @@ done:
     return rc;
 }
 
-/* ---- our V-cycle on several ranks ----------------------------------------- */
-
-/* The preconditioner's set-up as PCG calls it, once the hierarchy is set up. */
-static HYPRE_Int setup_done(HYPRE_Solver amg, HYPRE_ParCSRMatrix A, HYPRE_ParVector b,
-                            HYPRE_ParVector x)
+HYPRE_Int mf_hypre_keep_hierarchy(HYPRE_Solver amg, HYPRE_ParCSRMatrix A, HYPRE_ParVector b,
+                                  HYPRE_ParVector x)
 {
     (void)amg;
     (void)A;
@@ -663,6 +660,8 @@ static HYPRE_Int setup_done(HYPRE_Solver amg, HYPRE_ParCSRMatrix A, HYPRE_ParVec
     (void)x;
     return 0;
 }
+
+/* ---- our V-cycle on several ranks ----------------------------------------- */
 
 /* Why hypre's PCG runs instead of ours (why NULL: it does not), printed by
  * rank 0, once a module (pc->told). */
@@ -692,7 +691,7 @@ static int par_cycle_solve(const char *who, const mf_hypre_pcg *pcg, mf_hypre_pr
     if (pc->setup == HYPRE_BoomerAMGSetup) { /* a new hierarchy */
         MF_HYPRE_CALL(who, rc, fail, HYPRE_BoomerAMGSetup,
                       (pc->solver, sys->parA, sys->parb, sys->parx));
-        pc->setup = setup_done;
+        pc->setup = mf_hypre_keep_hierarchy;
         mf_amg_par_free(*pc->par);
         *pc->par = NULL;
         MF_CALL(mf_amg_par_take(pc->solver, pc->par, &why));

@@ -231,18 +231,6 @@ fail:
     return rc;
 }
 
-/* PCGSetup calls the preconditioner's setup; with a reused hierarchy that
- * call must leave it as it is. */
-static HYPRE_Int keep_hierarchy(HYPRE_Solver amg, HYPRE_ParCSRMatrix A, HYPRE_ParVector b,
-                                HYPRE_ParVector x)
-{
-    (void)amg;
-    (void)A;
-    (void)b;
-    (void)x;
-    return 0;
-}
-
 /* reuseHierarchy: whether the kept hierarchy may serve this solve in slot
  * space (same slots, same epoch, its iterations not grown too far) on this
  * rank. */
@@ -277,7 +265,7 @@ static int prepare_hypre(pcg_boomeramg *d, const mf_csr *A, const mf_row_names *
     if (rows && d->s.reuse_hierarchy) {
         if (may_keep(d, rows)) {
             d->reused = true;
-            *pc = (mf_hypre_precond){HYPRE_BoomerAMGSolve, keep_hierarchy, d->amg, NULL, NULL};
+            *pc = (mf_hypre_precond){HYPRE_BoomerAMGSolve, mf_hypre_keep_hierarchy, d->amg, NULL, NULL};
             return 0;
         }
         discard_hierarchy(d);
@@ -298,7 +286,7 @@ static int prepare_hypre(pcg_boomeramg *d, const mf_csr *A, const mf_row_names *
         if (d->amg && d->reuses_left > 0 && pattern == d->pattern) {
             d->reuses_left--;
             d->reused = true;
-            *pc = (mf_hypre_precond){HYPRE_BoomerAMGSolve, keep_hierarchy, d->amg, NULL, NULL};
+            *pc = (mf_hypre_precond){HYPRE_BoomerAMGSolve, mf_hypre_keep_hierarchy, d->amg, NULL, NULL};
             return 0;
         }
         discard_hierarchy(d);

@@ -134,6 +134,11 @@ int mf_hypre_setup_in_place(const char *who, HYPRE_Solver amg, const mf_csr *A,
 /* A 64-bit fingerprint of the sizes, row range and sparsity pattern of this
  * rank's rows, agreed over all ranks (the same value everywhere). */
 int mf_hypre_pattern_hash(const mf_csr *A, uint64_t *hash);
+/* The preconditioner set-up PCGSetup calls when the hierarchy is set up
+ * already (kept from an earlier solve, or our own cycle's): it leaves it
+ * as it is. */
+HYPRE_Int mf_hypre_keep_hierarchy(HYPRE_Solver amg, HYPRE_ParCSRMatrix A, HYPRE_ParVector b,
+                                  HYPRE_ParVector x);
 
 /* Check the settings both modules share; MF_ERR_INPUT naming the bad one. */
 int mf_hypre_check_pcg_settings(const char *who, double tolerance, long max_iter);
