@@ -268,6 +268,10 @@ static int build(mf_neighbours *nb, nb_class *c, const mf_particles *p)
     const double R = c->radius + c->skin;
     c->list_radius = 0;
     MF_CALL(mf_grid_build_reach(&c->grid, p, c->cell, R > c->cell ? 2 : 1));
+    /* The radix sort's buffers (24 bytes a particle) are dead once the grid
+     * is built: given back before the list build, whose scratch would
+     * otherwise stack on them (the step's peak, issue 12). */
+    mf_grid_release_scratch(&c->grid);
     const int self = (int)(c - nb->cls);
     c->sub_radius = 0;
     for (int k = 0; k < nb->nhandles; k++) {
@@ -287,7 +291,6 @@ static int build(mf_neighbours *nb, nb_class *c, const mf_particles *p)
     /* The builds' scratch is a fifth of the lists' memory; a run holds the
      * lists while the pressure solve's memory peaks, the scratch need not. */
     mf_nlist_release_scratch(&c->list);
-    mf_grid_release_scratch(&c->grid);
     const size_t np = p->n;
     if (np > c->cap_id) {
         size_t cap = np + np / 8 + 16;

@@ -34,6 +34,13 @@
 #include "neighbours_internal.h"
 #include "mf_alloc.h"
 
+#include <unistd.h> /* sysconf: the page size of fill_pass's releases */
+
+/* Scratch bytes (ranges and candidate bits) per block of the fill pass,
+ * given back after each block: about 5 blocks for the 3-D bench case's
+ * 5 MB. At least MF_RELEASE_MIN_BYTES, else a block gives nothing back. */
+#define FILL_BLOCK_BYTES ((size_t)1 << 20)
+
 /* ---- neighbour lists: memory ---------------------------------------------- */
 
 void mf_nlist_init(mf_nlist *nl)
@@ -589,17 +596,49 @@ static void count_pass(const list_build *lb, uint32_t *start, uint32_t *sstart)
         count_cell_as(lb, c, dim, keep_bits, sub, start, sstart);
 }
 
+/* Give back the whole pages of scratch in [*from, to), read for the last
+ * time (mf_release_pages; the partial page at `to` is kept), and move *from
+ * to the first page kept. Nothing happens below MF_RELEASE_MIN_BYTES: the
+ * range then grows with the next block. */
+static void release_read(char **from, char *to, uintptr_t page)
+{
+    if (to > *from && mf_release_pages(*from, (size_t)(to - *from)) > 0)
+        *from = (char *)((uintptr_t)to / page * page);
+}
+
+/* Pass 2 in blocks of consecutive cells, each block's scratch (its ranges
+ * and candidate bits, which no other cell reads) given back once its j's
+ * are written: the entries then grow into the pages the bits leave, and
+ * the list and its full scratch are never resident at once (issue 12).
+ * The cells and what each writes are those of one loop over all cells:
+ * the same list. */
 static void fill_pass(const list_build *lb, const uint32_t *start, uint32_t *jlist,
                       const uint32_t *sstart, uint32_t *sjlist)
 {
     const size_t ncells = lb->g->ncells;
     const int dim = lb->g->dim;
+    const long ps = sysconf(_SC_PAGESIZE);
+    const uintptr_t page = ps > 0 ? (uintptr_t)ps : 4096;
+    char *ranges_from = (char *)lb->cell_ranges, *bits_from = (char *)lb->bits;
+    for (size_t c0 = 0; c0 < ncells;) {
+        size_t c1 = c0, bytes = 0;
+        while (c1 < ncells && bytes < FILL_BLOCK_BYTES) {
+            bytes += lb->range_slots * sizeof(uint32_t);
+            if (lb->cell_word)
+                bytes += (lb->cell_word[c1 + 1] - lb->cell_word[c1]) * sizeof(uint64_t);
+            c1++;
+        }
 #pragma omp parallel for schedule(dynamic, 32)
-    for (size_t c = 0; c < ncells; c++) {
-        if (dim == 3)
-            fill_cell(lb, c, 3, start, jlist, sstart, sjlist);
-        else
-            fill_cell(lb, c, 2, start, jlist, sstart, sjlist);
+        for (size_t c = c0; c < c1; c++) {
+            if (dim == 3)
+                fill_cell(lb, c, 3, start, jlist, sstart, sjlist);
+            else
+                fill_cell(lb, c, 2, start, jlist, sstart, sjlist);
+        }
+        release_read(&ranges_from, (char *)(lb->cell_ranges + c1 * lb->range_slots), page);
+        if (lb->cell_word)
+            release_read(&bits_from, (char *)(lb->bits + lb->cell_word[c1]), page);
+        c0 = c1;
     }
 }
 
@@ -680,6 +719,13 @@ int mf_nlist_build_pair(mf_nlist *nl, mf_nlist *sub, const mf_grid *g, const mf_
         sub->n = 0;
         sub->radius = sub_radius;
     }
+    /* The old entries are dead from here; their pages, given back now, are
+     * not resident beside the scratch of the plan and count passes (the
+     * fill pass writes every entry again before anything reads one). */
+    if (nl->j)
+        (void)mf_release_pages(nl->j, nl->cap_j * sizeof *nl->j);
+    if (sub && sub->j)
+        (void)mf_release_pages(sub->j, sub->cap_j * sizeof *sub->j);
 
     list_build lb = {
         .g = g,
