@@ -642,6 +642,114 @@ static void test_locality_order(void)
     mf_particles_destroy(p);
 }
 
+/* ---- a large list, rebuilt in place -------------------------------------- */
+
+static const double *sort_pos; /* qsort has no context argument */
+static int compare_x(const void *a, const void *b)
+{
+    const double xa = sort_pos[3 * *(const uint32_t *)a], xb = sort_pos[3 * *(const uint32_t *)b];
+    return (xa > xb) - (xa < xb);
+}
+
+/* The list equals brute force as a set per particle, for sets too large
+ * for compare_with_brute_force: the pairs closer than radius found by a
+ * sweep along x (particles sorted by x, each paired with those less than
+ * radius ahead), every entry checked for distance and duplicates. */
+static size_t compare_with_sweep(const mf_nlist *nl, const mf_particles *p, double radius,
+                                 const char *what)
+{
+    const size_t n = p->n;
+    const double r2 = radius * radius;
+    CHECK_MSG(nl->n == n, "%s: list covers %zu particles, store has %zu", what, nl->n, n);
+    if (nl->n != n)
+        return n;
+    uint32_t *s = malloc((n ? n : 1) * sizeof *s);
+    size_t *count = calloc(n ? n : 1, sizeof *count);
+    uint32_t *got = malloc((n ? n : 1) * sizeof *got);
+    if (!s || !count || !got) {
+        fprintf(stderr, "out of memory in test\n");
+        exit(EXIT_FAILURE);
+    }
+    for (size_t i = 0; i < n; i++)
+        s[i] = (uint32_t)i;
+    sort_pos = p->pos;
+    qsort(s, n, sizeof *s, compare_x);
+    for (size_t a = 0; a < n; a++)
+        for (size_t b = a + 1; b < n && p->pos[3 * s[b]] - p->pos[3 * s[a]] < radius; b++)
+            if (dist2(p, s[a], s[b]) < r2) {
+                count[s[a]]++;
+                count[s[b]]++;
+            }
+    size_t bad = 0;
+    for (size_t i = 0; i < n; i++) {
+        const size_t ng = nl->start[i + 1] - nl->start[i];
+        bool ok = ng == count[i];
+        if (ok) {
+            memcpy(got, nl->j + nl->start[i], ng * sizeof *got);
+            qsort(got, ng, sizeof *got, compare_u32);
+            for (size_t e = 0; ok && e < ng; e++)
+                ok = got[e] != i && got[e] < n && dist2(p, i, got[e]) < r2 &&
+                     (e == 0 || got[e] > got[e - 1]);
+        }
+        if (!ok && bad++ < 5)
+            fprintf(stderr, "%s: particle %zu: %zu neighbours, brute force %zu\n", what, i, ng,
+                    count[i]);
+    }
+    free(s);
+    free(count);
+    free(got);
+    CHECK_MSG(bad == 0, "%s: %zu particles with a wrong list", what, bad);
+    return bad;
+}
+
+/* A list and sub-list rebuilt in place (the same arrays: the build gives
+ * the old entries' pages back first) after the particles moved, with a
+ * fill pass in several blocks (each block's scratch given back as it goes):
+ * the lists equal brute force and, entry for entry, the lists built into
+ * fresh arrays; a third build at the same positions, over scratch whose
+ * pages were given back, equals the second. */
+static void test_rebuild_in_place(void)
+{
+    mf_particles *p = random_points(3, 60000, 5.5);
+    const double radius = 0.3, sub_radius = 0.2;
+    mf_grid g;
+    mf_nlist nl, sub, fresh, fresh_sub;
+    mf_grid_init(&g);
+    mf_nlist_init(&nl);
+    mf_nlist_init(&sub);
+    mf_nlist_init(&fresh);
+    mf_nlist_init(&fresh_sub);
+    CHECK_OK(mf_grid_build(&g, p, radius));
+    CHECK_OK(mf_nlist_build_pair(&nl, &sub, &g, p, radius, sub_radius));
+    /* At least three blocks of nlist.c's FILL_BLOCK_BYTES (1 MiB) of scratch. */
+    CHECK_MSG(nl.work_bytes > ((size_t)2 << 20), "list scratch %zu bytes: too few blocks",
+              nl.work_bytes);
+    const uint32_t *j_before = nl.j, *sub_before = sub.j;
+    for (size_t i = 0; i < p->n; i++)
+        for (int d = 0; d < 3; d++)
+            p->pos[3 * i + d] += 0.01 * (uniform() - 0.5);
+    CHECK_OK(mf_grid_build(&g, p, radius));
+    CHECK_OK(mf_nlist_build_pair(&nl, &sub, &g, p, radius, sub_radius));
+    CHECK_MSG(nl.j == j_before && sub.j == sub_before,
+              "the rebuild did not reuse the arrays (the case this test is for)");
+    compare_with_sweep(&nl, p, radius, "list rebuilt in place");
+    compare_with_sweep(&sub, p, sub_radius, "sub-list rebuilt in place");
+    CHECK_OK(mf_nlist_build_pair(&fresh, &fresh_sub, &g, p, radius, sub_radius));
+    CHECK(fresh.start[p->n] == nl.start[p->n] && fresh_sub.start[p->n] == sub.start[p->n]);
+    CHECK(memcmp(fresh.start, nl.start, (p->n + 1) * sizeof(uint32_t)) == 0);
+    CHECK(memcmp(fresh.j, nl.j, nl.start[p->n] * sizeof(uint32_t)) == 0);
+    CHECK(memcmp(fresh_sub.j, sub.j, sub.start[p->n] * sizeof(uint32_t)) == 0);
+    CHECK_OK(mf_nlist_build_pair(&fresh, &fresh_sub, &g, p, radius, sub_radius));
+    CHECK(memcmp(fresh.j, nl.j, nl.start[p->n] * sizeof(uint32_t)) == 0);
+    CHECK(memcmp(fresh_sub.j, sub.j, sub.start[p->n] * sizeof(uint32_t)) == 0);
+    mf_nlist_free(&nl);
+    mf_nlist_free(&sub);
+    mf_nlist_free(&fresh);
+    mf_nlist_free(&fresh_sub);
+    mf_grid_free(&g);
+    mf_particles_destroy(p);
+}
+
 static void test_errors(void)
 {
     mf_grid g;
@@ -686,6 +794,7 @@ int main(void)
     test_determinism();
     test_locality_order();
     test_sort_moved();
+    test_rebuild_in_place(); /* last: its draws would change the points above */
     test_errors();
     return mf_test_summary("neighbours");
 }
