@@ -168,14 +168,14 @@ int mf_amg_par_pcg(mf_amg_par *v, HYPRE_ParCSRMatrix A, HYPRE_ParVector b, HYPRE
                    double bnorm, double tol, long max_iter, int *iterations, double *rel,
                    const char **why);
 /* The rows' slots over the ranks (hypre_common.c's slot space): this rank's
- * slot of each row, its slots [first, first + nslots) of hypre's rows, the
- * slot of every global row (column), the first slot of each rank (nprocs +
- * 1 entries). */
+ * slot of each row, its slots [first, first + nslots) of hypre's rows, and
+ * the other ranks' rows its rows read (the halo of columns, halo_columns.h:
+ * the fine level's offd columns, in the halo's order, and its exchange
+ * plan). */
 typedef struct mf_par_slots {
     const int64_t *slot;
     int64_t nslots, first;
-    const int *of_row;
-    const int64_t *starts;
+    const struct mf_halo_columns *halo;
 } mf_par_slots;
 /* Collective: mf_amg_par_pcg for the caller's rows A in slot space, the
  * fine level built from them without a hypre matrix (a kept hierarchy's

@@ -22,6 +22,7 @@
 #include "pressure_hypre.h"
 
 #include "amg_vcycle.h"
+#include "halo_columns.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -465,73 +466,51 @@ static int set_fine(mf_amg_par *v, hypre_ParCSRMatrix *A, const char **why)
 
 /* ---- the fine level from the caller's rows ------------------------------------ */
 
-static int cmp_int(const void *a, const void *b)
-{
-    const int x = *(const int *)a, y = *(const int *)b;
-    return (x > y) - (x < y);
-}
-
 /* This rank's rows of A in slot space as hypre_common.c's assembly makes
  * them (a slot no row names: d x = 0, d the rows' mean |diagonal|), the
- * columns this rank's slots (diag) or other ranks' (offd, in ascending
- * global slot), and the comm package that moves the offd values: each rank
- * asks the owners for the slots it reads (MPI_Alltoall of the counts,
- * MPI_Alltoallv of the slots). */
+ * columns this rank's slots (diag) or other ranks' rows (offd), and the comm
+ * package that moves the offd values: the solve's halo of columns
+ * (halo_columns.h), whose plan says which of this rank's rows each rank
+ * reads (sent from their slots here) and whose order numbers the offd
+ * columns (a non-zero's offd column is its column's place in the halo).
+ * hypre numbers them by ascending global slot instead; a row's offd sum
+ * reads the same values in the same order either way, so the cycle's
+ * results are the same bit for bit. No value a global row: O(local rows
+ * and halo) memory, no exchange of its own. */
 static int build_rows_block(par_block *F, const mf_csr *A, const mf_par_slots *ps)
 {
-    int nprocs = 1;
-    MPI_Comm_size(MPI_COMM_WORLD, &nprocs);
+    const mf_halo_columns *h = ps->halo;
+    const int nprocs = h->nprocs;
     const int32_t n = (int32_t)ps->nslots, nrows = (int32_t)A->nrows;
-    const int first = (int)ps->first, total = (int)ps->starts[nprocs];
     const size_t k0 = nrows > 0 ? A->rowptr[0] : 0;
     const size_t nnz = nrows > 0 ? A->rowptr[nrows] - k0 : 0;
     int rc = 0;
     int32_t *row_of = malloc(((size_t)n + 1) * sizeof *row_of);
-    int *loc = malloc(((size_t)total + 1) * sizeof *loc);
-    int *cmap = malloc((nnz + 1) * sizeof *cmap);
     F->own_oi = malloc(((size_t)n + 1) * sizeof *F->own_oi);
     F->own_oj = malloc((nnz + 1) * sizeof *F->own_oj);
     F->own_ov = malloc((nnz + 1) * sizeof *F->own_ov);
-    int *need = calloc((size_t)nprocs, sizeof *need), *give = calloc((size_t)nprocs, sizeof *give);
-    int *nd = calloc((size_t)nprocs, sizeof *nd), *gd = calloc((size_t)nprocs, sizeof *gd);
-    int *req = NULL;
-    if (!row_of || !loc || !cmap || !F->own_oi || !F->own_oj || !F->own_ov || !need || !give ||
-        !nd || !gd)
+    if (!row_of || !F->own_oi || !F->own_oj || !F->own_ov)
         rc = MF_ERROR(MF_ERR_MEMORY, "out of memory for the fine level (%d slots)", n);
     if (rc == 0)
         rc = mf_split_csr_reserve(&F->D, (size_t)n, nnz);
     MF_CALL_GOTO(rc, mf_hypre_agree("PCG_BoomerAMG", rc), out);
 
-    /* The other ranks' slots read, once each (loc marks them), then in
-     * ascending order (loc: their offd column). */
     for (int32_t s = 0; s < n; s++)
         row_of[s] = -1;
-    for (int g = 0; g < total; g++)
-        loc[g] = -1;
     double dsum = 0.0;
-    int ncm = 0;
     for (int32_t r = 0; r < nrows; r++) {
         row_of[ps->slot[r]] = r;
-        for (size_t k = A->rowptr[r]; k < A->rowptr[r + 1]; k++) {
-            const int g = ps->of_row[A->col[k]];
-            if (g >= first && g < first + n) {
-                if (A->col[k] == A->row_offset + r)
-                    dsum += fabs(A->val[k]);
-            } else if (loc[g] < 0) {
-                loc[g] = 0;
-                cmap[ncm++] = g;
-            }
-        }
+        for (size_t k = A->rowptr[r]; k < A->rowptr[r + 1]; k++)
+            if (A->col[k] == A->row_offset + r)
+                dsum += fabs(A->val[k]);
     }
-    qsort(cmap, (size_t)ncm, sizeof *cmap, cmp_int);
-    for (int j = 0; j < ncm; j++)
-        loc[cmap[j]] = j;
     const double dfree = nrows > 0 && dsum > 0 ? dsum / nrows : 1.0;
 
     /* The rows by slot: the diag block (local columns) straight into the
      * split layout, in one pass over the row for the lower part, the
      * diagonal and the offd block, one more for the upper part: the layout
-     * and the bits mf_split_csr_set makes of the diag block's CSR. */
+     * and the bits mf_split_csr_set makes of the diag block's CSR. A
+     * column's place in [rows | halo] (h->ext) says which it is. */
     mf_split_csr *S = &F->D;
     int32_t kd = 0, ko = 0;
     S->ptr[0] = 0;
@@ -543,9 +522,9 @@ static int build_rows_block(par_block *F, const mf_csr *A, const mf_par_slots *p
             d += dfree;
         else {
             for (size_t k = A->rowptr[r]; k < A->rowptr[r + 1]; k++) {
-                const int g = ps->of_row[A->col[k]];
-                if (g >= first && g < first + n) {
-                    const int32_t c = g - first;
+                const int32_t e = h->ext[k - k0];
+                if (e < nrows) {
+                    const int32_t c = (int32_t)ps->slot[e];
                     if (c == s)
                         d += A->val[k];
                     else if (c < s) {
@@ -553,16 +532,16 @@ static int build_rows_block(par_block *F, const mf_csr *A, const mf_par_slots *p
                         S->val_buf[kd++] = A->val[k];
                     }
                 } else {
-                    F->own_oj[ko] = loc[g];
+                    F->own_oj[ko] = e - nrows;
                     F->own_ov[ko++] = A->val[k];
                 }
             }
         }
         S->mid[s] = kd;
         for (size_t k = r < 0 ? 0 : A->rowptr[r]; r >= 0 && k < A->rowptr[r + 1]; k++) {
-            const int g = ps->of_row[A->col[k]];
-            if (g > first + s && g < first + n) {
-                S->col_buf[kd] = g - first;
+            const int32_t e = h->ext[k - k0];
+            if (e < nrows && (int32_t)ps->slot[e] > s) {
+                S->col_buf[kd] = (int32_t)ps->slot[e];
                 S->val_buf[kd++] = A->val[k];
             }
         }
@@ -572,59 +551,49 @@ static int build_rows_block(par_block *F, const mf_csr *A, const mf_par_slots *p
     }
     F->own_oi[n] = ko;
     F->n = n;
-    F->ncols_offd = ncm;
+    F->ncols_offd = h->n;
     F->oi = ko > 0 ? F->own_oi : NULL;
     F->oj = F->own_oj;
     F->ov = F->own_ov;
 
-    /* What this rank reads from each rank, and what each reads from it. */
-    for (int j = 0, p = 0; j < ncm; j++) {
-        while (cmap[j] >= ps->starts[p + 1])
-            p++;
-        need[p]++;
-    }
-    MPI_Alltoall(need, 1, MPI_INT, give, 1, MPI_INT, MPI_COMM_WORLD);
-    int ngive = 0, nrecv = 0, nsend = 0;
+    /* The comm package from the halo's plan: the ranks this one reads from
+     * (its halo, grouped by owner) and those that read from it. */
+    int nrecv = 0, nsend = 0;
     for (int p = 0; p < nprocs; p++) {
-        nd[p] = p > 0 ? nd[p - 1] + need[p - 1] : 0;
-        gd[p] = ngive;
-        ngive += give[p];
-        nrecv += need[p] > 0;
-        nsend += give[p] > 0;
+        nrecv += h->recv_counts[p] > 0;
+        nsend += h->send_counts[p] > 0;
     }
-    req = malloc(((size_t)ngive + 1) * sizeof *req);
     HYPRE_Int *recv_procs = hypre_CTAlloc(HYPRE_Int, nrecv + 1, HYPRE_MEMORY_HOST);
     HYPRE_Int *recv_starts = hypre_CTAlloc(HYPRE_Int, nrecv + 1, HYPRE_MEMORY_HOST);
     HYPRE_Int *send_procs = hypre_CTAlloc(HYPRE_Int, nsend + 1, HYPRE_MEMORY_HOST);
     HYPRE_Int *send_starts = hypre_CTAlloc(HYPRE_Int, nsend + 1, HYPRE_MEMORY_HOST);
-    HYPRE_Int *send_elmts = hypre_CTAlloc(HYPRE_Int, ngive + 1, HYPRE_MEMORY_HOST);
-    if (!req || !recv_procs || !recv_starts || !send_procs || !send_starts || !send_elmts)
+    HYPRE_Int *send_elmts = hypre_CTAlloc(HYPRE_Int, h->nsend + 1, HYPRE_MEMORY_HOST);
+    if (!recv_procs || !recv_starts || !send_procs || !send_starts || !send_elmts)
         rc = MF_ERROR(MF_ERR_MEMORY, "out of memory for the fine level's halo (%d values)",
-                      ngive);
+                      (int)h->nsend);
     if (mf_hypre_agree("PCG_BoomerAMG", rc) == 0) {
-        MPI_Alltoallv(cmap, need, nd, MPI_INT, req, give, gd, MPI_INT, MPI_COMM_WORLD);
         int q = 0;
         for (int p = 0; p < nprocs; p++)
-            if (need[p] > 0) {
+            if (h->recv_counts[p] > 0) {
                 recv_procs[q] = p;
-                recv_starts[++q] = nd[p] + need[p];
+                recv_starts[++q] = h->recv_displs[p] + h->recv_counts[p];
             }
         q = 0;
         for (int p = 0; p < nprocs; p++)
-            if (give[p] > 0) {
+            if (h->send_counts[p] > 0) {
                 send_procs[q] = p;
-                send_starts[++q] = gd[p] + give[p];
+                send_starts[++q] = h->send_displs[p] + h->send_counts[p];
             }
-        for (int k = 0; k < ngive; k++)
-            send_elmts[k] = req[k] - first;
+        for (int32_t k = 0; k < h->nsend; k++)
+            send_elmts[k] = (HYPRE_Int)ps->slot[h->send_rows[k]];
         hypre_ParCSRCommPkgCreateAndFill(MPI_COMM_WORLD, nrecv, recv_procs, recv_starts, nsend,
                                          send_procs, send_starts, send_elmts, &F->pkg);
         F->own_pkg = true;
-        F->nsend = ngive;
-        F->send = malloc(((size_t)ngive + 1) * sizeof *F->send);
-        F->halo = calloc((size_t)ncm + 1, sizeof *F->halo);
+        F->nsend = h->nsend;
+        F->send = malloc(((size_t)h->nsend + 1) * sizeof *F->send);
+        F->halo = calloc((size_t)h->n + 1, sizeof *F->halo);
         if (!F->send || !F->halo)
-            rc = MF_ERROR(MF_ERR_MEMORY, "out of memory for a halo of %d values", ncm);
+            rc = MF_ERROR(MF_ERR_MEMORY, "out of memory for a halo of %d values", (int)h->n);
     } else {
         hypre_TFree(recv_procs, HYPRE_MEMORY_HOST);
         hypre_TFree(recv_starts, HYPRE_MEMORY_HOST);
@@ -635,13 +604,6 @@ static int build_rows_block(par_block *F, const mf_csr *A, const mf_par_slots *p
     rc = mf_hypre_agree("PCG_BoomerAMG", rc);
 out:
     free(row_of);
-    free(loc);
-    free(cmap);
-    free(need);
-    free(give);
-    free(nd);
-    free(gd);
-    free(req);
     return rc;
 }
 

@@ -20,6 +20,7 @@
 #include <mpi.h>
 
 #include "amg_vcycle.h"
+#include "halo_columns.h"
 #include "mf_error.h"
 #include "mf_hash.h"
 #include "row_dot.h"
@@ -177,7 +178,8 @@ static int check_system(const char *who, const mf_csr *A, const double *b, const
                             who, A->nglobal, A->row_offset, A->row_offset + (int64_t)A->nrows);
         return 0;
     }
-    /* Several ranks: the residual gathers x, so offsets must fit an int too. */
+    /* Several ranks: MPI counts and offsets (the layout, the halo of
+     * columns) are ints, so the rows must fit one too. */
     int rc = 0;
     int64_t mine[3] = {A->row_offset, (int64_t)A->nrows, A->nglobal};
     int64_t *all = malloc(3 * (size_t)lay->nprocs * sizeof *all);
@@ -226,38 +228,46 @@ static double global_sum(double local)
 
 /* ||b - A x|| over all ranks, from the caller's CSR (independent of the hypre
  * copy, so a wrong assembly would show here). On several ranks the columns
- * of other ranks need their x: gather the whole vector (O(nglobal) memory
- * per rank; good enough until the solver runs on many ranks). */
+ * of other ranks need their x: the halo of columns brings exactly those
+ * (halo_columns.h), into xe = [x | halo], which each non-zero reads through
+ * its ext index: the same values in the same order as a gathered x. */
 static int residual_norm(const char *who, const mf_csr *A, const double *b, const double *x,
-                         const layout *lay, double *norm)
+                         mf_halo_columns *halo, double *norm)
 {
-    const double *xg = x;
-    int64_t shift = A->row_offset; /* global column -> index into xg */
-    double *gathered = NULL;
+    const double *xe = x;
+    const int32_t *ext = NULL;
+    double *buf = NULL;
     int rc = 0;
-    if (lay->nprocs > 1) {
-        gathered = malloc(((size_t)A->nglobal + 1) * sizeof *gathered);
-        if (gathered == NULL)
-            rc = MF_ERROR(MF_ERR_MEMORY, "%s: out of memory gathering x (%" PRId64 " rows)", who,
-                          A->nglobal);
+    if (halo != NULL) {
+        buf = malloc((A->nrows + (size_t)halo->n + 1) * sizeof *buf);
+        if (buf == NULL)
+            rc = MF_ERROR(MF_ERR_MEMORY, "%s: out of memory for x and its halo (%zu + %d rows)",
+                          who, A->nrows, (int)halo->n);
         rc = mf_hypre_agree(who, rc);
         if (rc != 0) {
-            free(gathered);
+            free(buf);
             return mf_error_trace(rc, __FILE__, __LINE__, __func__);
         }
-        MPI_Allgatherv(x, (int)A->nrows, MPI_DOUBLE, gathered, lay->counts, lay->displs,
-                       MPI_DOUBLE, MPI_COMM_WORLD);
-        xg = gathered;
-        shift = 0;
+        if (A->nrows > 0)
+            memcpy(buf, x, A->nrows * sizeof *buf);
+        mf_halo_columns_doubles(halo, x, buf + A->nrows);
+        xe = buf;
+        ext = halo->ext;
     }
+    const size_t k0 = A->nrows > 0 ? A->rowptr[0] : 0;
+    const int64_t shift = A->row_offset; /* one rank: global column -> row */
     double sum = 0.0;
     for (size_t i = 0; i < A->nrows; i++) {
         double r = b[i];
-        for (size_t k = A->rowptr[i]; k < A->rowptr[i + 1]; k++)
-            r -= A->val[k] * xg[A->col[k] - shift];
+        if (ext != NULL)
+            for (size_t k = A->rowptr[i]; k < A->rowptr[i + 1]; k++)
+                r -= A->val[k] * xe[ext[k - k0]];
+        else
+            for (size_t k = A->rowptr[i]; k < A->rowptr[i + 1]; k++)
+                r -= A->val[k] * xe[A->col[k] - shift];
         sum += r * r;
     }
-    free(gathered);
+    free(buf);
     *norm = sqrt(global_sum(sum));
     return 0;
 }
@@ -288,30 +298,35 @@ static double residual_local(const void *ctx, const double *x, double *r)
  * the slots of the ranks before it, so each rank's hypre rows stay its own
  * and keep their meaning while its particles do (a kept hierarchy's
  * partition is then still the matrix's). A column names a global row, which
- * may be another rank's: on several ranks every rank gathers the global
- * slot of every global row (of_row, one int a row: O(nglobal) memory, as
- * the residual's gathered x; good enough until many ranks). */
+ * may be another rank's: on several ranks its owner sends the global slot of
+ * each of its rows this rank reads, once a solve, through the halo of
+ * columns (halo_slot; halo_columns.h: O(halo) a rank, not O(nglobal)). */
 typedef struct slot_space {
-    const mf_row_names *rows; /* NULL: row space */
-    int64_t first;            /* this rank's first hypre row (0 on one rank) */
-    int64_t total;            /* slots of all ranks */
-    int *of_row;              /* several ranks: hypre row of each global row */
-    int64_t *starts;          /* several ranks: first slot of each rank (nprocs + 1) */
+    const mf_row_names *rows;      /* NULL: row space */
+    int64_t first;                 /* this rank's first hypre row (0 on one rank) */
+    int64_t total;                 /* slots of all ranks */
+    const mf_halo_columns *halo;   /* several ranks: the other ranks' rows read */
+    int *halo_slot;                /* several ranks: hypre row of each of them */
+    int64_t *starts;               /* several ranks: first slot of each rank (nprocs + 1) */
 } slot_space;
 
 static void slot_space_free(slot_space *ss)
 {
-    free(ss->of_row);
+    free(ss->halo_slot);
     free(ss->starts);
     memset(ss, 0, sizeof *ss);
 }
 
-/* The hypre row of the matrix's global row (column) c. */
-static HYPRE_BigInt slot_of_column(const slot_space *ss, const mf_csr *A, int64_t c)
+/* The hypre row of the column of A's non-zero k. */
+static HYPRE_BigInt slot_of_column(const slot_space *ss, const mf_csr *A, size_t k)
 {
-    if (ss->of_row)
-        return (HYPRE_BigInt)ss->of_row[c];
-    return (HYPRE_BigInt)(ss->first + ss->rows->slot[c - A->row_offset]);
+    if (ss->halo) {
+        const int32_t e = ss->halo->ext[k - A->rowptr[0]];
+        if (e >= (int32_t)A->nrows)
+            return (HYPRE_BigInt)ss->halo_slot[e - (int32_t)A->nrows];
+        return (HYPRE_BigInt)(ss->first + ss->rows->slot[e]);
+    }
+    return (HYPRE_BigInt)(ss->first + ss->rows->slot[A->col[k] - A->row_offset]);
 }
 
 /* This rank's check of the names: one per row, distinct, in [0, nslots). */
@@ -339,9 +354,10 @@ static int check_names(const char *who, const mf_csr *A, const mf_row_names *row
     return rc;
 }
 
-/* Collective: the slot space of this solve (rows NULL: row space). */
+/* Collective: the slot space of this solve (rows NULL: row space); halo:
+ * the solve's halo of columns on several ranks. */
 static int slot_space_build(const char *who, const mf_csr *A, const mf_row_names *rows,
-                            const layout *lay, slot_space *ss)
+                            const layout *lay, mf_halo_columns *halo, slot_space *ss)
 {
     memset(ss, 0, sizeof *ss);
     ss->rows = rows;
@@ -354,11 +370,12 @@ static int slot_space_build(const char *who, const mf_csr *A, const mf_row_names
     int rc = 0;
     int64_t *nslots = malloc((size_t)lay->nprocs * sizeof *nslots);
     int *mine = malloc((A->nrows + 1) * sizeof *mine);
-    ss->of_row = malloc(((size_t)A->nglobal + 1) * sizeof *ss->of_row);
+    ss->halo = halo;
+    ss->halo_slot = malloc(((size_t)halo->n + 1) * sizeof *ss->halo_slot);
     ss->starts = malloc(((size_t)lay->nprocs + 1) * sizeof *ss->starts);
-    if (nslots == NULL || mine == NULL || ss->of_row == NULL || ss->starts == NULL)
-        rc = MF_ERROR(MF_ERR_MEMORY, "%s: out of memory for the slots of %" PRId64 " rows", who,
-                      A->nglobal);
+    if (nslots == NULL || mine == NULL || ss->halo_slot == NULL || ss->starts == NULL)
+        rc = MF_ERROR(MF_ERR_MEMORY, "%s: out of memory for the slots of %zu rows and %d more",
+                      who, A->nrows, (int)halo->n);
     MF_CALL_GOTO(rc, mf_hypre_agree(who, rc), fail);
     MPI_Allgather(&rows->nslots, 1, MPI_INT64_T, nslots, 1, MPI_INT64_T, MPI_COMM_WORLD);
     int rank = 0;
@@ -379,8 +396,7 @@ static int slot_space_build(const char *who, const mf_csr *A, const mf_row_names
     }
     for (size_t i = 0; i < A->nrows; i++)
         mine[i] = (int)(ss->first + rows->slot[i]);
-    MPI_Allgatherv(mine, (int)A->nrows, MPI_INT, ss->of_row, lay->counts, lay->displs, MPI_INT,
-                   MPI_COMM_WORLD);
+    mf_halo_columns_ints(halo, mine, ss->halo_slot);
     free(nslots);
     free(mine);
     return 0;
@@ -500,7 +516,7 @@ static int assemble(const char *who, const mf_csr *A, const slot_space *ss, cons
             sys->rows[i] = ilower + (HYPRE_BigInt)s;
             ncols[i] = (HYPRE_Int)(A->rowptr[i + 1] - A->rowptr[i]);
             for (size_t k = A->rowptr[i]; k < A->rowptr[i + 1]; k++) {
-                const HYPRE_BigInt c = slot_of_column(ss, A, A->col[k]);
+                const HYPRE_BigInt c = slot_of_column(ss, A, k);
                 cols[k - k0] = c;
                 if (c >= ilower && c <= iupper)
                     ndiag++;
@@ -581,7 +597,7 @@ int mf_hypre_setup_cycle(const char *who, HYPRE_Solver amg, const mf_csr *A,
         HYPRE_BoomerAMGDestroy(amg);
         return MF_ERROR(MF_ERR_MEMORY, "%s: out of memory (%zu rows)", who, A->nrows);
     }
-    const slot_space ss = {rows, 0, rows ? rows->nslots : 0, NULL, NULL}; /* one rank */
+    const slot_space ss = {rows, 0, rows ? rows->nslots : 0, NULL, NULL, NULL}; /* one rank */
     rc = rows ? check_names(who, A, rows) : 0;
     bool in_place = false; /* hypre's matrix in A's arrays: no copy of A */
     if (rc == 0)
@@ -719,8 +735,7 @@ static int par_rows_solve(const char *who, const mf_hypre_pcg *pcg, mf_hypre_pre
                           double bnorm, mf_solve_report *rep, double t_start, double *t_solve,
                           bool *ran)
 {
-    const mf_par_slots ps = {ss->rows->slot, ss->rows->nslots, ss->first, ss->of_row,
-                             ss->starts};
+    const mf_par_slots ps = {ss->rows->slot, ss->rows->nslots, ss->first, ss->halo};
     const char *why = NULL;
     *t_solve = MPI_Wtime();
     rep->setup_seconds = *t_solve - t_start;
@@ -757,6 +772,32 @@ int mf_hypre_pattern_hash(const mf_csr *A, uint64_t *hash)
 
 /* ---- the solve ----------------------------------------------------------- */
 
+/* MF_HALO_BYTES set: one line a rank a solve on stderr, the bytes this rank
+ * received from the others in the exchanges of other ranks' rows (the halo's
+ * build: its counts and requests; the slots; x for each residual), counted
+ * as they are made, against what the gathers they replaced received for
+ * the same solve, reckoned from their counts (an MPI_Allgatherv receives
+ * every other rank's rows): one int a global row for the slots, one double
+ * a global row for each residual, and the rows block's own MPI_Alltoall and
+ * MPI_Alltoallv of its requests (nprocs - 1 counts, one int a value asked of
+ * this rank). */
+static void tell_bytes(const mf_csr *A, const layout *lay, const mf_halo_columns *h,
+                       bool slots, int residuals, bool rows_block)
+{
+    int rank = 0;
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    const uint64_t others = (uint64_t)A->nglobal - A->nrows;
+    const uint64_t gathers =
+        (slots ? others * sizeof(int) : 0) + others * sizeof(double) * (uint64_t)residuals +
+        (rows_block ? (uint64_t)(lay->nprocs - 1) * sizeof(int) + (uint64_t)h->nsend * sizeof(int)
+                    : 0);
+    fprintf(stderr,
+            "MF_HALO_BYTES rank %d: rows %zu of %" PRId64 ", halo %d, asked %d, residuals %d, "
+            "slots %d, rows block %d: received %" PRIu64 " B, gathers %" PRIu64 " B\n",
+            rank, A->nrows, A->nglobal, (int)h->n, (int)h->nsend, residuals, (int)slots,
+            (int)rows_block, h->bytes_received, gathers);
+}
+
 int mf_hypre_pcg_solve(const mf_hypre_pcg *pcg, const mf_csr *A, const double *b, double *x,
                        mf_solve_report *rep)
 {
@@ -770,6 +811,11 @@ int mf_hypre_pcg_solve(const mf_hypre_pcg *pcg, const mf_csr *A, const double *b
     HYPRE_Solver solver = NULL;
     bool prepared = false, converged = false;
     double *r = NULL;
+    mf_halo_columns halo_store = {0}, *halo = NULL; /* several ranks */
+    /* MF_HALO_BYTES: what the exchanges of other ranks' rows received, and
+     * what the gathers of one value a global row they replace received. */
+    int residuals = 0;
+    bool rows_block = false;
     int rc = 0;
 
     if (rep == NULL)
@@ -796,6 +842,13 @@ int mf_hypre_pcg_solve(const mf_hypre_pcg *pcg, const mf_csr *A, const double *b
         rep->setup_seconds = MPI_Wtime() - t_start;
         goto done;
     }
+    /* Several ranks: the other ranks' rows this rank's rows read, for the
+     * residuals, the slots and our cycle's fine level (halo_columns.h). */
+    if (lay.nprocs > 1) {
+        MF_CALL_GOTO(rc, mf_halo_columns_build(who, A, lay.displs, lay.nprocs, &halo_store),
+                     done);
+        halo = &halo_store;
+    }
     /* One rank with a module that runs its own V-cycle: the residual vector
      * is PCG's start. */
     const bool own = lay.nprocs == 1 && pcg->cycle_prepare != NULL;
@@ -809,8 +862,10 @@ int mf_hypre_pcg_solve(const mf_hypre_pcg *pcg, const mf_csr *A, const double *b
             goto done;
         }
         rnorm = residual_local(&loc, x, r);
-    } else
-        MF_CALL_GOTO(rc, residual_norm(who, A, b, x, &lay, &rnorm), done);
+    } else {
+        MF_CALL_GOTO(rc, residual_norm(who, A, b, x, halo, &rnorm), done);
+        residuals++;
+    }
     rep->initial_residual = rnorm / bnorm;
     if (!isfinite(rep->initial_residual)) {
         rc = MF_ERROR(MF_ERR_NUMERIC,
@@ -834,7 +889,7 @@ int mf_hypre_pcg_solve(const mf_hypre_pcg *pcg, const mf_csr *A, const double *b
     /* Slot space when the rows are named: each rank's slots a block of
      * hypre's rows (slot_space). */
     const mf_row_names *rows = pcg->rows;
-    MF_CALL_GOTO(rc, slot_space_build(who, A, rows, &lay, &ss), done);
+    MF_CALL_GOTO(rc, slot_space_build(who, A, rows, &lay, halo, &ss), done);
     if (own) {
         mf_amg_vcycle *cycle = NULL;
         MF_CALL_GOTO(rc, pcg->cycle_prepare(pcg->ctx, A, rows, &cycle), done);
@@ -864,11 +919,13 @@ int mf_hypre_pcg_solve(const mf_hypre_pcg *pcg, const mf_csr *A, const double *b
     double t_solve = MPI_Wtime();
     bool ran = false; /* our PCG and V-cycle on several ranks */
     if (lay.nprocs > 1 && pc.par != NULL && *pc.par != NULL && pc.setup != HYPRE_BoomerAMGSetup &&
-        ss.rows != NULL)
+        ss.rows != NULL) {
         /* A kept hierarchy: the fine level from the caller's rows, no hypre matrix. */
+        rows_block = true;
         MF_CALL_GOTO(rc, par_rows_solve(who, pcg, &pc, A, &ss, b, x, bnorm, rep, t_start,
                                         &t_solve, &ran),
                      done);
+    }
     /* Our PCG over the caller's rows has the honest number already: its last
      * residual is the true ||b - A x|| of those rows (build_rows_block in
      * amg_vcycle_par.c copies them, no hypre assembly in between), as the
@@ -890,7 +947,8 @@ int mf_hypre_pcg_solve(const mf_hypre_pcg *pcg, const mf_csr *A, const double *b
 
     /* The honest number: ||b - A x|| / ||b|| from the caller's matrix. */
     if (!rows_residual) {
-        MF_CALL_GOTO(rc, residual_norm(who, A, b, x, &lay, &rnorm), done);
+        MF_CALL_GOTO(rc, residual_norm(who, A, b, x, halo, &rnorm), done);
+        residuals++;
         rep->final_residual = rnorm / bnorm;
     }
     converged = rep->final_residual <= pcg->tolerance; /* false for NaN */
@@ -903,7 +961,10 @@ done:
     if (prepared && pcg->precond_release)
         pcg->precond_release(pcg->ctx, rep, rc == 0 && converged);
     system_free(&sys);
+    if (halo != NULL && getenv("MF_HALO_BYTES") != NULL)
+        tell_bytes(A, &lay, halo, ss.rows != NULL, residuals, rows_block);
     slot_space_free(&ss);
+    mf_halo_columns_free(&halo_store);
     layout_free(&lay);
     free(r);
     if (rc == 0 && !converged)
