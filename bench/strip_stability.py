@@ -25,7 +25,8 @@ Weights and n0_g as core/particles/mf_kernel.h: paper, wendland, wendlandW.
 M: wavenumbers along x (of WIDTH/l0 = 40 columns; 20 = alternate columns);
 default 4 8 12 16 20. Env FIXTOP=1 holds the surface row still (fixed like
 a wall, its pressure 0 kept), leaving the bulk's own growth. Needs h5dump;
-no numpy. Env L0: the spacing (default 0.01)."""
+no numpy. Env L0: the spacing (default 0.01). Env SURF_PHAT=c: the surface row's p^
+set to -c rho g l0 (docs/notes/mps.md, "surfrow")."""
 import cmath
 import math
 import os
@@ -37,6 +38,9 @@ from layer_mode import dataset  # noqa: E402
 
 L0 = float(os.environ.get("L0", "0.01"))  # the spacing (bench/periodic_layer.sh's L0)
 WIDTH, RHO = 0.4, 1000.0
+# Env SURF_PHAT=c: the surface row's p^_i set to -c rho g l0 (its own row's
+# pairs then push with P = c rho g l0: the "surfrow" section's treatment)
+SURF_PHAT = float(os.environ.get("SURF_PHAT", "0"))
 
 
 def rows_of(path):
@@ -63,6 +67,7 @@ def build(rows, wf, re, k):
     n0g = sum(wf(L0 * math.hypot(ix, iy), re) for ix in range(-m, m + 1) for iy in range(-m, m + 1))
     coef = 2.0 / (RHO * n0g)
     fluid = [i for i, r in enumerate(rows) if r[2]]
+    fluid_all = list(fluid)
     if os.environ.get("FIXTOP"):  # the surface row held still: the bulk's own growth
         fluid = fluid[:-1]
     dof = {row: n for n, row in enumerate(fluid)}
@@ -77,6 +82,8 @@ def build(rows, wf, re, k):
                 if 0.0 < r < re:
                     nbrs.append((rj, x, y, r, pj))
         phat = min([pi] + [n[4] for n in nbrs])
+        if ri == fluid_all[-1] and SURF_PHAT:  # the surface row's p^ below zero ("surfrow")
+            phat = -SURF_PHAT * RHO * 9.81 * L0
         ni = dof[ri]
         for rj, x, y, r, pj in nbrs:
             eps = 1e-6 * r
