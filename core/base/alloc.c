@@ -23,14 +23,19 @@ int mf_resize(void *pp, size_t n, size_t elem)
     return 0;
 }
 
+size_t mf_page_size(void)
+{
+    const long ps = sysconf(_SC_PAGESIZE);
+    return ps > 0 ? (size_t)ps : 0;
+}
+
 size_t mf_release_pages(void *ptr, size_t bytes)
 {
     if (!ptr || bytes < MF_RELEASE_MIN_BYTES)
         return 0;
-    const long ps = sysconf(_SC_PAGESIZE);
-    if (ps <= 0)
+    const uintptr_t page = (uintptr_t)mf_page_size(), start = (uintptr_t)ptr;
+    if (page == 0)
         return 0;
-    const uintptr_t page = (uintptr_t)ps, start = (uintptr_t)ptr;
     const uintptr_t first = (start + page - 1) / page * page; /* whole pages only */
     const uintptr_t end = (start + bytes) / page * page;
     if (end <= first)

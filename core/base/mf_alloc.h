@@ -28,6 +28,8 @@ int mf_resize(void *pp, size_t n, size_t elem);
  * when the system refused (nothing is lost then but the saving). */
 #define MF_RELEASE_MIN_BYTES ((size_t)64 * 1024)
 size_t mf_release_pages(void *ptr, size_t bytes);
+/* The system's page size in bytes (0 when it cannot say). */
+size_t mf_page_size(void);
 
 #pragma GCC visibility pop
 #endif

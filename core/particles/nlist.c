@@ -34,8 +34,6 @@
 #include "neighbours_internal.h"
 #include "mf_alloc.h"
 
-#include <unistd.h> /* sysconf: the page size of fill_pass's releases */
-
 /* Scratch bytes (ranges and candidate bits) per block of the fill pass,
  * given back after each block: about 5 blocks for the 3-D bench case's
  * 5 MB. At least MF_RELEASE_MIN_BYTES, else a block gives nothing back. */
@@ -617,8 +615,7 @@ static void fill_pass(const list_build *lb, const uint32_t *start, uint32_t *jli
 {
     const size_t ncells = lb->g->ncells;
     const int dim = lb->g->dim;
-    const long ps = sysconf(_SC_PAGESIZE);
-    const uintptr_t page = ps > 0 ? (uintptr_t)ps : 4096;
+    const uintptr_t page = (uintptr_t)mf_page_size(); /* 0: nothing is released */
     char *ranges_from = (char *)lb->cell_ranges, *bits_from = (char *)lb->bits;
     for (size_t c0 = 0; c0 < ncells;) {
         size_t c1 = c0, bytes = 0;

@@ -150,20 +150,26 @@ fail:
     return rc;
 }
 
+/* halo[j] = local[col[j]'s row] for elements of `size` bytes: the owner
+ * packs the rows asked of it into send (nsend elements), one MPI_Alltoallv. */
+static void exchange(mf_halo_columns *h, const void *local, void *send, size_t size,
+                     MPI_Datatype type, void *halo)
+{
+    const char *from = local;
+    char *to = send;
+    for (int32_t k = 0; k < h->nsend; k++)
+        memcpy(to + (size_t)k * size, from + (size_t)h->send_rows[k] * size, size);
+    MPI_Alltoallv(send, h->send_counts, h->send_displs, type, halo, h->recv_counts,
+                  h->recv_displs, type, MPI_COMM_WORLD);
+    h->bytes_received += (uint64_t)h->n * size;
+}
+
 void mf_halo_columns_doubles(mf_halo_columns *h, const double *local, double *halo)
 {
-    for (int32_t k = 0; k < h->nsend; k++)
-        h->send_d[k] = local[h->send_rows[k]];
-    MPI_Alltoallv(h->send_d, h->send_counts, h->send_displs, MPI_DOUBLE, halo, h->recv_counts,
-                  h->recv_displs, MPI_DOUBLE, MPI_COMM_WORLD);
-    h->bytes_received += (uint64_t)h->n * sizeof(double);
+    exchange(h, local, h->send_d, sizeof *local, MPI_DOUBLE, halo);
 }
 
 void mf_halo_columns_ints(mf_halo_columns *h, const int *local, int *halo)
 {
-    for (int32_t k = 0; k < h->nsend; k++)
-        h->send_i[k] = local[h->send_rows[k]];
-    MPI_Alltoallv(h->send_i, h->send_counts, h->send_displs, MPI_INT, halo, h->recv_counts,
-                  h->recv_displs, MPI_INT, MPI_COMM_WORLD);
-    h->bytes_received += (uint64_t)h->n * sizeof(int);
+    exchange(h, local, h->send_i, sizeof *local, MPI_INT, halo);
 }

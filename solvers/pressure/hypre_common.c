@@ -78,15 +78,13 @@ int mf_hypre_check_pcg_settings(const char *who, double tolerance, long max_iter
 
 typedef struct layout {
     int nprocs;
-    int *counts; /* rows of each rank (only when nprocs > 1) */
-    int *displs; /* first global row of each rank */
+    int *displs; /* first global row of each rank (only when nprocs > 1) */
 } layout;
 
 static void layout_free(layout *lay)
 {
-    free(lay->counts);
     free(lay->displs);
-    lay->counts = lay->displs = NULL;
+    lay->displs = NULL;
 }
 
 /* Is every column in [0, nglobal)? Four at a time (GCC/clang vector
@@ -183,9 +181,8 @@ static int check_system(const char *who, const mf_csr *A, const double *b, const
     int rc = 0;
     int64_t mine[3] = {A->row_offset, (int64_t)A->nrows, A->nglobal};
     int64_t *all = malloc(3 * (size_t)lay->nprocs * sizeof *all);
-    lay->counts = malloc((size_t)lay->nprocs * sizeof *lay->counts);
     lay->displs = malloc((size_t)lay->nprocs * sizeof *lay->displs);
-    if (all == NULL || lay->counts == NULL || lay->displs == NULL)
+    if (all == NULL || lay->displs == NULL)
         rc = MF_ERROR(MF_ERR_MEMORY, "%s: out of memory for the row layout", who);
     MF_CALL_GOTO(rc, mf_hypre_agree(who, rc), fail);
     MPI_Allgather(mine, 3, MPI_INT64_T, all, 3, MPI_INT64_T, MPI_COMM_WORLD);
@@ -201,7 +198,6 @@ static int check_system(const char *who, const mf_csr *A, const double *b, const
             goto fail;
         }
         lay->displs[p] = (int)r[0];
-        lay->counts[p] = (int)r[1];
         next = r[0] + r[1];
     }
     if (next != A->nglobal) {
@@ -307,13 +303,11 @@ typedef struct slot_space {
     int64_t total;                 /* slots of all ranks */
     const mf_halo_columns *halo;   /* several ranks: the other ranks' rows read */
     int *halo_slot;                /* several ranks: hypre row of each of them */
-    int64_t *starts;               /* several ranks: first slot of each rank (nprocs + 1) */
 } slot_space;
 
 static void slot_space_free(slot_space *ss)
 {
     free(ss->halo_slot);
-    free(ss->starts);
     memset(ss, 0, sizeof *ss);
 }
 
@@ -372,8 +366,7 @@ static int slot_space_build(const char *who, const mf_csr *A, const mf_row_names
     int *mine = malloc((A->nrows + 1) * sizeof *mine);
     ss->halo = halo;
     ss->halo_slot = malloc(((size_t)halo->n + 1) * sizeof *ss->halo_slot);
-    ss->starts = malloc(((size_t)lay->nprocs + 1) * sizeof *ss->starts);
-    if (nslots == NULL || mine == NULL || ss->halo_slot == NULL || ss->starts == NULL)
+    if (nslots == NULL || mine == NULL || ss->halo_slot == NULL)
         rc = MF_ERROR(MF_ERR_MEMORY, "%s: out of memory for the slots of %zu rows and %d more",
                       who, A->nrows, (int)halo->n);
     MF_CALL_GOTO(rc, mf_hypre_agree(who, rc), fail);
@@ -384,10 +377,8 @@ static int slot_space_build(const char *who, const mf_csr *A, const mf_row_names
     for (int p = 0; p < lay->nprocs; p++) {
         if (p == rank)
             ss->first = ss->total;
-        ss->starts[p] = ss->total;
         ss->total += nslots[p];
     }
-    ss->starts[lay->nprocs] = ss->total;
     /* Every rank computed the same total: the same decision everywhere. */
     if (ss->total > HYPRE_BIGINT_MAX || ss->total > INT_MAX) {
         rc = MF_ERROR(MF_ERR_INPUT, "%s: %" PRId64 " slots over the ranks exceed hypre's index",
@@ -597,7 +588,7 @@ int mf_hypre_setup_cycle(const char *who, HYPRE_Solver amg, const mf_csr *A,
         HYPRE_BoomerAMGDestroy(amg);
         return MF_ERROR(MF_ERR_MEMORY, "%s: out of memory (%zu rows)", who, A->nrows);
     }
-    const slot_space ss = {rows, 0, rows ? rows->nslots : 0, NULL, NULL, NULL}; /* one rank */
+    const slot_space ss = {rows, 0, rows ? rows->nslots : 0, NULL, NULL}; /* one rank */
     rc = rows ? check_names(who, A, rows) : 0;
     bool in_place = false; /* hypre's matrix in A's arrays: no copy of A */
     if (rc == 0)
